@@ -1,0 +1,33 @@
+# Warning set shared by every target of the project. Targets opt in through
+# rover_target_defaults() so third-party code is never compiled with -Werror.
+add_library(rover_warnings INTERFACE)
+target_compile_options(rover_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast
+  -Wcast-align -Wunused -Woverloaded-virtual -Wconversion -Wsign-conversion
+  -Wnull-dereference -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  target_compile_options(rover_warnings INTERFACE
+    -Wmisleading-indentation -Wduplicated-cond -Wduplicated-branches -Wlogical-op)
+endif()
+if(ROVER_WARNINGS_AS_ERRORS)
+  target_compile_options(rover_warnings INTERFACE -Werror)
+endif()
+
+# Applies the project defaults to a target: include root, warnings.
+function(rover_target_defaults target)
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
+  target_link_libraries(${target} PRIVATE rover_warnings)
+endfunction()
+
+# rover_add_test(NAME name SOURCES a.cc b.cc LIBS libs... [LABELS l...])
+# One gtest executable, registered test-by-test with ctest.
+function(rover_add_test)
+  cmake_parse_arguments(ARG "" "NAME" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${ARG_NAME} ${ARG_SOURCES})
+  rover_target_defaults(${ARG_NAME})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LIBS} GTest::gmock GTest::gtest_main)
+  gtest_discover_tests(${ARG_NAME}
+    PROPERTIES LABELS "${ARG_LABELS}"
+               ENVIRONMENT "ROVER_SOURCE_DIR=${PROJECT_SOURCE_DIR};ROVER_SHARED_DIR=${PROJECT_SOURCE_DIR}/../shared"
+    DISCOVERY_TIMEOUT 60)
+endfunction()

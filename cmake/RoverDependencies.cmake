@@ -1,0 +1,21 @@
+# Every external dependency comes from a Debian 12 package installed by
+# scripts/install_deps.sh; find them all in one place.
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
+
+if(NOT ROVER_FUZZ)
+  find_package(yaml-cpp REQUIRED)
+  find_package(CLI11 REQUIRED)
+  find_package(iceoryx_posh REQUIRED)
+  find_package(iceoryx_hoofs REQUIRED)
+  if(ROVER_BUILD_TESTS)
+    find_package(GTest REQUIRED)
+    include(GoogleTest)
+  endif()
+  if(ROVER_BUILD_BENCHMARKS)
+    find_package(benchmark REQUIRED)
+  endif()
+endif()

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Installs everything the project needs, from Debian 12 packages and pinned npm
+# packages. Idempotent: packages already present are skipped, so a second run
+# is quick and never prompts. Later work appends to the lists below, one
+# package per line with the reason it is here.
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(dirname "$here")"
+
+# package                      reason
+DEBIAN_PACKAGES=(
+  build-essential            # GCC 12 toolchain (C++20)
+  cmake                      # build system, >= 3.25 on Debian 12
+  ninja-build                # generator used by every preset
+  pkg-config                 # locates zstd / lz4 / yaml-cpp
+  git                        # version stamp in logs, fresh-clone checks
+  clang                      # libFuzzer targets (tests/fuzz)
+  libclang-rt-14-dev         # libFuzzer + sanitizer runtimes for clang
+  clang-format               # style check of the sources in CI
+  libeigen3-dev              # geometry, estimator linear algebra
+  libyaml-cpp-dev            # board configuration files (core/config)
+  libgtest-dev               # unit tests
+  libgmock-dev               # unit tests (matchers, mocks of interfaces)
+  libbenchmark-dev           # printed benchmark figures (bench/)
+  libzstd-dev                # MCAP chunk compression (default)
+  zstd                       # command-line zstd, for inspecting logs
+  liblz4-dev                 # MCAP chunk compression (option)
+  libcli11-dev               # command-line parsing of host tools
+  iceoryx                    # iox-roudi, the shared-memory broker
+  libiceoryx-posh-dev        # iceoryx publish/subscribe API (core/ipc)
+  nodejs                     # independent MCAP reader for conformance tests
+)
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then
+  if command -v sudo >/dev/null; then SUDO="sudo"; else
+    echo "install_deps: need root or sudo to install Debian packages" >&2; exit 1
+  fi
+fi
+
+missing=()
+for pkg in "${DEBIAN_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
+done
+# npm ships inside some Node.js builds (NodeSource) and separately in Debian's;
+# installing Debian's npm next to a NodeSource node would conflict.
+command -v npm >/dev/null || missing+=(npm)
+
+if ((${#missing[@]})); then
+  echo "install_deps: installing ${missing[*]}"
+  $SUDO apt-get update
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
+else
+  echo "install_deps: all Debian packages present"
+fi
+
+# npm packages, pinned by tests/conformance/package-lock.json.
+if [[ -f "$root/tests/conformance/package-lock.json" ]]; then
+  lock_hash=$(sha256sum "$root/tests/conformance/package-lock.json" | cut -d' ' -f1)
+  stamp="$root/tests/conformance/node_modules/.lock-hash"
+  if [[ ! -f "$stamp" || "$(cat "$stamp")" != "$lock_hash" ]]; then
+    echo "install_deps: npm ci in tests/conformance"
+    (cd "$root/tests/conformance" && npm ci --no-audit --no-fund --loglevel=error)
+    echo "$lock_hash" >"$stamp"
+  fi
+fi
