@@ -1,0 +1,198 @@
+#include "core/log/msgs/definitions.h"
+
+#include <algorithm>
+#include <array>
+
+namespace rover::log::internal {
+namespace {
+
+struct OwnText {
+  std::string_view type;  // "pkg/Type"
+  std::string_view text;  // Field and constant lines, '\n'-separated, no trailing newline.
+};
+
+// Field types, names, order, defaults and constants follow the ROS 2 Humble
+// .msg files (comments omitted). A reader decodes our CDR bytes by walking
+// these texts, so any divergence from the real definitions corrupts decoding.
+// Types from the same package are written unqualified, as in the originals.
+constexpr std::array kOwnTexts = {
+    OwnText{"builtin_interfaces/Time",
+            "int32 sec\n"
+            "uint32 nanosec"},
+    OwnText{"std_msgs/Header",
+            "builtin_interfaces/Time stamp\n"
+            "string frame_id"},
+    OwnText{"geometry_msgs/Vector3",
+            "float64 x\n"
+            "float64 y\n"
+            "float64 z"},
+    OwnText{"geometry_msgs/Point",
+            "float64 x\n"
+            "float64 y\n"
+            "float64 z"},
+    OwnText{"geometry_msgs/Quaternion",
+            "float64 x 0\n"
+            "float64 y 0\n"
+            "float64 z 0\n"
+            "float64 w 1"},
+    OwnText{"geometry_msgs/Pose",
+            "Point position\n"
+            "Quaternion orientation"},
+    OwnText{"geometry_msgs/PoseWithCovariance",
+            "Pose pose\n"
+            "float64[36] covariance"},
+    OwnText{"geometry_msgs/PoseWithCovarianceStamped",
+            "std_msgs/Header header\n"
+            "PoseWithCovariance pose"},
+    OwnText{"geometry_msgs/Twist",
+            "Vector3 linear\n"
+            "Vector3 angular"},
+    OwnText{"geometry_msgs/TwistWithCovariance",
+            "Twist twist\n"
+            "float64[36] covariance"},
+    OwnText{"geometry_msgs/Transform",
+            "Vector3 translation\n"
+            "Quaternion rotation"},
+    OwnText{"geometry_msgs/TransformStamped",
+            "std_msgs/Header header\n"
+            "string child_frame_id\n"
+            "Transform transform"},
+    OwnText{"sensor_msgs/Imu",
+            "std_msgs/Header header\n"
+            "geometry_msgs/Quaternion orientation\n"
+            "float64[9] orientation_covariance\n"
+            "geometry_msgs/Vector3 angular_velocity\n"
+            "float64[9] angular_velocity_covariance\n"
+            "geometry_msgs/Vector3 linear_acceleration\n"
+            "float64[9] linear_acceleration_covariance"},
+    OwnText{"sensor_msgs/Image",
+            "std_msgs/Header header\n"
+            "uint32 height\n"
+            "uint32 width\n"
+            "string encoding\n"
+            "uint8 is_bigendian\n"
+            "uint32 step\n"
+            "uint8[] data"},
+    OwnText{"nav_msgs/Odometry",
+            "std_msgs/Header header\n"
+            "string child_frame_id\n"
+            "geometry_msgs/PoseWithCovariance pose\n"
+            "geometry_msgs/TwistWithCovariance twist"},
+    OwnText{"tf2_msgs/TFMessage", "geometry_msgs/TransformStamped[] transforms"},
+    OwnText{"diagnostic_msgs/KeyValue",
+            "string key\n"
+            "string value"},
+    OwnText{"diagnostic_msgs/DiagnosticStatus",
+            "byte OK=0\n"
+            "byte WARN=1\n"
+            "byte ERROR=2\n"
+            "byte STALE=3\n"
+            "byte level\n"
+            "string name\n"
+            "string message\n"
+            "string hardware_id\n"
+            "KeyValue[] values"},
+    OwnText{"diagnostic_msgs/DiagnosticArray",
+            "std_msgs/Header header\n"
+            "DiagnosticStatus[] status"},
+    // The project's own types: see core/log/msgs/rover_msgs.h for semantics.
+    OwnText{"rover_msgs/LogChannelHealth",
+            "string topic\n"
+            "uint64 records_written\n"
+            "uint64 records_dropped\n"
+            "uint32 ring_high_water"},
+    OwnText{"rover_msgs/LogHealth",
+            "std_msgs/Header header\n"
+            "uint64 records_written\n"
+            "uint64 bytes_written\n"
+            "LogChannelHealth[] channels"},
+};
+
+// The primitive types of the ROS 2 interface definition language.
+constexpr std::array<std::string_view, 17> kPrimitiveTypes = {
+    "bool",  "byte",   "char",  "float32", "float64", "int8",    "uint8", "int16",   "uint16",
+    "int32", "uint32", "int64", "uint64",  "string",  "wstring", "time",  "duration"};
+
+// "pkg/msg/Type" -> "pkg/Type"; other spellings are returned unchanged.
+std::string NormalizeName(std::string_view type) {
+  const size_t first = type.find('/');
+  const size_t last = type.rfind('/');
+  if (first != std::string_view::npos && last != first &&
+      type.substr(first, last - first) == "/msg") {
+    std::string result(type.substr(0, first));
+    result += type.substr(last);
+    return result;
+  }
+  return std::string(type);
+}
+
+std::string_view Trim(std::string_view s) {
+  const size_t begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string_view::npos) return {};
+  const size_t end = s.find_last_not_of(" \t\r");
+  return s.substr(begin, end - begin + 1);
+}
+
+void AppendClosure(std::string_view type, std::vector<std::string>* seen, std::string* out) {
+  for (const std::string& dependency : DirectDependencies(type)) {
+    if (std::find(seen->begin(), seen->end(), dependency) != seen->end()) continue;
+    seen->push_back(dependency);
+    *out += '\n';
+    out->append(80, '=');
+    *out += "\nMSG: ";
+    *out += dependency;
+    *out += '\n';
+    *out += OwnDefinition(dependency);
+    AppendClosure(dependency, seen, out);
+  }
+}
+
+}  // namespace
+
+std::string_view OwnDefinition(std::string_view type) {
+  const std::string name = NormalizeName(type);
+  for (const OwnText& entry : kOwnTexts) {
+    if (entry.type == name) return entry.text;
+  }
+  return {};
+}
+
+std::vector<std::string> DirectDependencies(std::string_view type) {
+  const std::string name = NormalizeName(type);
+  const std::string_view package = std::string_view(name).substr(0, name.find('/'));
+  std::vector<std::string> dependencies;
+  std::string_view text = OwnDefinition(name);
+  while (!text.empty()) {
+    const size_t newline = text.find('\n');
+    std::string_view line = text.substr(0, newline);
+    text = newline == std::string_view::npos ? std::string_view{} : text.substr(newline + 1);
+    line = Trim(line.substr(0, line.find('#')));
+    if (line.empty()) continue;
+    // The type is the first token, minus any array suffix ("[]", "[9]",
+    // "[<=4]") or string bound ("<=8").
+    std::string_view field_type = line.substr(0, line.find_first_of(" \t"));
+    field_type = field_type.substr(0, field_type.find_first_of("[<"));
+    if (std::find(kPrimitiveTypes.begin(), kPrimitiveTypes.end(), field_type) !=
+        kPrimitiveTypes.end()) {
+      continue;
+    }
+    if (field_type.find('/') == std::string_view::npos) {
+      std::string qualified(package);
+      qualified += '/';
+      qualified += field_type;
+      dependencies.push_back(std::move(qualified));
+    } else {
+      dependencies.push_back(NormalizeName(field_type));
+    }
+  }
+  return dependencies;
+}
+
+std::string ComposeDefinition(std::string_view type) {
+  std::string out(OwnDefinition(type));
+  std::vector<std::string> seen = {NormalizeName(type)};
+  AppendClosure(type, &seen, &out);
+  return out;
+}
+
+}  // namespace rover::log::internal
