@@ -20,15 +20,29 @@ function(rover_target_defaults target)
   target_link_libraries(${target} PRIVATE rover_warnings)
 endfunction()
 
-# rover_add_test(NAME name SOURCES a.cc b.cc LIBS libs... [LABELS l...])
-# One gtest executable, registered test-by-test with ctest.
+# rover_add_test(NAME name SOURCES a.cc b.cc LIBS libs... [LABELS l...] [RESOURCE_LOCK r])
+# One gtest executable, registered test-by-test with ctest. Labels select the
+# sanitizer runs (asan, tsan); RESOURCE_LOCK serialises tests sharing one
+# machine-wide resource (e.g. "roudi").
+#
+# Properties are applied by a script that ctest includes after discovery:
+# gtest_discover_tests(PROPERTIES ...) flattens list values, which would keep
+# only the first label and the first environment variable.
 function(rover_add_test)
-  cmake_parse_arguments(ARG "" "NAME" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;RESOURCE_LOCK" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SOURCES})
   rover_target_defaults(${ARG_NAME})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LIBS} GTest::gmock GTest::gtest_main)
-  gtest_discover_tests(${ARG_NAME}
-    PROPERTIES LABELS "${ARG_LABELS}"
-               ENVIRONMENT "ROVER_SOURCE_DIR=${PROJECT_SOURCE_DIR};ROVER_SHARED_DIR=${PROJECT_SOURCE_DIR}/../shared"
-    DISCOVERY_TIMEOUT 60)
+  gtest_discover_tests(${ARG_NAME} TEST_LIST ${ARG_NAME}_TESTS DISCOVERY_TIMEOUT 60)
+  set(environment
+      "ROVER_SOURCE_DIR=${PROJECT_SOURCE_DIR};ROVER_SHARED_DIR=${PROJECT_SOURCE_DIR}/../shared")
+  set(properties "LABELS \"${ARG_LABELS}\" ENVIRONMENT \"${environment}\"")
+  if(ARG_RESOURCE_LOCK)
+    string(APPEND properties " RESOURCE_LOCK \"${ARG_RESOURCE_LOCK}\"")
+  endif()
+  set(script "${CMAKE_CURRENT_BINARY_DIR}/${ARG_NAME}_properties.cmake")
+  file(WRITE "${script}" "if(${ARG_NAME}_TESTS)\n"
+    "  set_tests_properties(\${${ARG_NAME}_TESTS} PROPERTIES ${properties})\n"
+    "endif()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script}")
 endfunction()

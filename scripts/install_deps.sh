@@ -26,6 +26,7 @@ DEBIAN_PACKAGES=(
   libzstd-dev                # MCAP chunk compression (default)
   zstd                       # command-line zstd, for inspecting logs
   liblz4-dev                 # MCAP chunk compression (option)
+  zlib1g-dev                 # CRC-32 of MCAP records (zlib crc32)
   libcli11-dev               # command-line parsing of host tools
   iceoryx                    # iox-roudi, the shared-memory broker
   libiceoryx-posh-dev        # iceoryx publish/subscribe API (core/ipc)

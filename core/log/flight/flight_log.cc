@@ -59,6 +59,8 @@ void FlightLog::Start() {
 
 void FlightLog::Run() {
   Time next_health = Time::Now() + options_.health_period;
+  Time last_chunk_flush = Time::Now();
+  const Duration max_chunk_age = Duration::Nanoseconds(options_.mcap.max_chunk_duration_ns);
   for (;;) {
     {
       // Only the writer thread and Stop() use this lock; producers never do.
@@ -68,7 +70,15 @@ void FlightLog::Run() {
       if (stop_requested_) return;
     }
     DrainAll();
-    if (const Time now = Time::Now(); now >= next_health) {
+    const Time now = Time::Now();
+    if (now - last_chunk_flush >= max_chunk_age) {
+      // The MCAP writer closes a chunk by age only when a message arrives;
+      // when producers go quiet, close it here so power loss cannot take
+      // more than one chunk period of data with it.
+      FlushChunk();
+      last_chunk_flush = now;
+    }
+    if (now >= next_health) {
       WriteHealth(now);
       next_health = now + options_.health_period;
     }
@@ -92,6 +102,15 @@ void FlightLog::DrainAll() {
   }
   std::lock_guard lock(stats_mutex_);
   mcap_stats_ = writer_.stats();
+}
+
+void FlightLog::FlushChunk() {
+  try {
+    writer_.FlushChunk();
+  } catch (const std::exception& e) {
+    std::lock_guard lock(stats_mutex_);
+    if (error_.empty()) error_ = e.what();
+  }
 }
 
 void FlightLog::WriteHealth(Time now) {

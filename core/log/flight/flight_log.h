@@ -84,6 +84,7 @@ class FlightLog {
   uint16_t SchemaFor(std::string_view name, std::string_view definition);
   void Run();
   void DrainAll();
+  void FlushChunk();
   void WriteHealth(Time now);
 
   FlightLogOptions options_;

@@ -74,7 +74,7 @@ bool ReadPrimitive(CdrReader& r, FieldKind kind, FlatField* f) {
     case FieldKind::kFloat32: {
       float v = 0;
       if (!r.ReadF32("", &v)) return false;
-      f->value = double{v};
+      f->value = static_cast<double>(v);
       return true;
     }
     case FieldKind::kFloat64: {
