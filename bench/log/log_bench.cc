@@ -12,8 +12,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -160,8 +160,8 @@ void RealtimeCostBenchmark(const std::string& dir, int calls) {
       Serialize(msg, w);
       asm volatile("" : : "r"(buffer.data()) : "memory");
     }
-    serialize_ns = std::min(serialize_ns, static_cast<double>((Time::Now() - t0).nanoseconds()) /
-                                              (calls / 5));
+    serialize_ns =
+        std::min(serialize_ns, static_cast<double>((Time::Now() - t0).nanoseconds()) / (calls / 5));
   }
 
   // Reference 2: push+pop of the same 1 KiB slot through the SPSC ring.
@@ -177,7 +177,8 @@ void RealtimeCostBenchmark(const std::string& dir, int calls) {
       ring->CommitPush();
       ring->PopFront();
     }
-    ring_ns = std::min(ring_ns, static_cast<double>((Time::Now() - t0).nanoseconds()) / (calls / 5));
+    ring_ns =
+        std::min(ring_ns, static_cast<double>((Time::Now() - t0).nanoseconds()) / (calls / 5));
   }
 
   // The real path: LogChannel::Log with the writer thread draining to disk.

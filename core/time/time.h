@@ -44,8 +44,14 @@ class Duration {
   constexpr double operator/(Duration o) const {
     return static_cast<double>(ns_) / static_cast<double>(o.ns_);
   }
-  constexpr Duration& operator+=(Duration o) { ns_ += o.ns_; return *this; }
-  constexpr Duration& operator-=(Duration o) { ns_ -= o.ns_; return *this; }
+  constexpr Duration& operator+=(Duration o) {
+    ns_ += o.ns_;
+    return *this;
+  }
+  constexpr Duration& operator-=(Duration o) {
+    ns_ -= o.ns_;
+    return *this;
+  }
   constexpr auto operator<=>(const Duration&) const = default;
 
   /// Human-readable form with a unit chosen by magnitude: "1.500 s", "250 us".
@@ -77,8 +83,14 @@ class Time {
   constexpr Time operator+(Duration d) const { return Time(ns_ + d.nanoseconds()); }
   constexpr Time operator-(Duration d) const { return Time(ns_ - d.nanoseconds()); }
   constexpr Duration operator-(Time o) const { return Duration::Nanoseconds(ns_ - o.ns_); }
-  constexpr Time& operator+=(Duration d) { ns_ += d.nanoseconds(); return *this; }
-  constexpr Time& operator-=(Duration d) { ns_ -= d.nanoseconds(); return *this; }
+  constexpr Time& operator+=(Duration d) {
+    ns_ += d.nanoseconds();
+    return *this;
+  }
+  constexpr Time& operator-=(Duration d) {
+    ns_ -= d.nanoseconds();
+    return *this;
+  }
   constexpr auto operator<=>(const Time&) const = default;
 
   /// "12.345678901 s" (seconds since boot, full nanosecond precision).

@@ -24,11 +24,10 @@ TrajectorySample AnalyticTrajectory::Evaluate(double t_s) const {
   const double yaw = w * t_s, yaw_rate = w;
   const double pitch = o.pitch_amplitude_rad * sa, pitch_rate = o.pitch_amplitude_rad * wa * ca;
   const double roll = o.roll_amplitude_rad * ca, roll_rate = -o.roll_amplitude_rad * wa * sa;
-  const Eigen::Matrix3d R_local_body =
-      (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d R_local_body = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                        Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                        Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                           .toRotationMatrix();
   out.q_local_body = Eigen::Quaterniond(R_local_body);
   // Body rates from Z-Y-X Euler rates (exact kinematic relation).
   const double sr = std::sin(roll), cr = std::cos(roll);

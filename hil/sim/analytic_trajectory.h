@@ -29,7 +29,7 @@ struct TrajectorySample {
   Eigen::Vector3d p_local_body;
   Eigen::Vector3d v_local_body_m_s;
   Eigen::Quaterniond q_local_body;
-  Eigen::Vector3d omega_body_rad_s;        ///< angular rate, body axes
+  Eigen::Vector3d omega_body_rad_s;          ///< angular rate, body axes
   Eigen::Vector3d specific_force_body_m_s2;  ///< what an ideal accelerometer measures
 };
 

@@ -19,8 +19,7 @@ Eigen::Vector3d ImuErrorModel::Gaussian3(double sigma) {
 }
 
 ImuMeasurement ImuErrorModel::Apply(const Eigen::Vector3d& omega_true_rad_s,
-                                    const Eigen::Vector3d& specific_force_true_m_s2,
-                                    double dt_s) {
+                                    const Eigen::Vector3d& specific_force_true_m_s2, double dt_s) {
   const double sqrt_dt = std::sqrt(dt_s);
   gyro_bias_rad_s_ += Gaussian3(options_.gyro_bias_random_walk_rad_s2_sqrt_hz * sqrt_dt);
   accel_bias_m_s2_ += Gaussian3(options_.accel_bias_random_walk_m_s3_sqrt_hz * sqrt_dt);

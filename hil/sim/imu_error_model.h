@@ -12,11 +12,11 @@ namespace rover::sim {
 
 /// Defaults are an MTi-10-class MEMS unit.
 struct ImuErrorOptions {
-  double gyro_noise_density_rad_s_sqrt_hz = 1.7e-4;     // 0.01 deg/s/sqrt(Hz)
-  double accel_noise_density_m_s2_sqrt_hz = 6.0e-4;     // 60 ug/sqrt(Hz)
+  double gyro_noise_density_rad_s_sqrt_hz = 1.7e-4;  // 0.01 deg/s/sqrt(Hz)
+  double accel_noise_density_m_s2_sqrt_hz = 6.0e-4;  // 60 ug/sqrt(Hz)
   double gyro_bias_random_walk_rad_s2_sqrt_hz = 2.0e-5;
   double accel_bias_random_walk_m_s3_sqrt_hz = 1.0e-4;
-  double gyro_turn_on_bias_sigma_rad_s = 3.5e-3;         // 0.2 deg/s
+  double gyro_turn_on_bias_sigma_rad_s = 3.5e-3;  // 0.2 deg/s
   double accel_turn_on_bias_sigma_m_s2 = 0.03;
   uint64_t seed = 1;
 };

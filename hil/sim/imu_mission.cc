@@ -96,10 +96,10 @@ ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& s
 
   const double dt_s = 1.0 / options.imu_rate_hz;
   const Duration dt = Duration::FromSeconds(dt_s);
-  const auto samples = static_cast<uint64_t>(std::llround(options.duration_s * options.imu_rate_hz));
-  const auto truth_every =
-      std::max<uint64_t>(1, static_cast<uint64_t>(std::llround(options.imu_rate_hz /
-                                                               options.ground_truth_rate_hz)));
+  const auto samples =
+      static_cast<uint64_t>(std::llround(options.duration_s * options.imu_rate_hz));
+  const auto truth_every = std::max<uint64_t>(
+      1, static_cast<uint64_t>(std::llround(options.imu_rate_hz / options.ground_truth_rate_hz)));
   // Preallocated so the loop itself never allocates.
   std::vector<double> log_cost_ns(samples), lateness_us(options.lockstep ? 0 : samples);
   std::atomic<uint64_t> done{0};
@@ -143,14 +143,13 @@ ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& s
     next_print_s = elapsed + 1.0;
     const log::FlightLogStats s = flight_log.stats();
     char line[200];
-    std::snprintf(line, sizeof line,
-                  "t=%6.1f s  imu %7llu/%llu  logged %8llu  written %8llu  dropped %llu  log %s",
-                  elapsed, static_cast<unsigned long long>(done.load()),
-                  static_cast<unsigned long long>(samples),
-                  static_cast<unsigned long long>(s.logged),
-                  static_cast<unsigned long long>(s.written),
-                  static_cast<unsigned long long>(s.dropped),
-                  std::to_string(s.mcap.bytes_written / 1024).append(" KiB").c_str());
+    std::snprintf(
+        line, sizeof line,
+        "t=%6.1f s  imu %7llu/%llu  logged %8llu  written %8llu  dropped %llu  log %s", elapsed,
+        static_cast<unsigned long long>(done.load()), static_cast<unsigned long long>(samples),
+        static_cast<unsigned long long>(s.logged), static_cast<unsigned long long>(s.written),
+        static_cast<unsigned long long>(s.dropped),
+        std::to_string(s.mcap.bytes_written / 1024).append(" KiB").c_str());
     status << (tty ? "\r" : "") << line << (tty ? "" : "\n") << std::flush;
   }
   imu_thread.join();
@@ -170,8 +169,8 @@ ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& s
   result.realtime_priority = realtime.load();
   result.log_call_ns_p50 = Percentile(log_cost_ns, 0.5);
   result.log_call_ns_p99 = Percentile(log_cost_ns, 0.99);
-  result.log_call_ns_max = log_cost_ns.empty() ? 0.0 : *std::max_element(log_cost_ns.begin(),
-                                                                         log_cost_ns.end());
+  result.log_call_ns_max =
+      log_cost_ns.empty() ? 0.0 : *std::max_element(log_cost_ns.begin(), log_cost_ns.end());
   result.tick_lateness_us_p99 = Percentile(lateness_us, 0.99);
   return result;
 }
@@ -186,8 +185,7 @@ void PrintImuMissionSummary(const ImuMissionOptions& options, const ImuMissionRe
   std::snprintf(line, sizeof line, "  imu thread:       %s\n",
                 r.realtime_priority ? "SCHED_FIFO" : "normal priority (no real-time privilege)");
   out << line;
-  std::snprintf(line, sizeof line,
-                "  records:          %llu logged, %llu written, %llu dropped\n",
+  std::snprintf(line, sizeof line, "  records:          %llu logged, %llu written, %llu dropped\n",
                 static_cast<unsigned long long>(r.records_logged),
                 static_cast<unsigned long long>(r.records_written),
                 static_cast<unsigned long long>(r.records_dropped));

@@ -1,7 +1,7 @@
 // rover-sim: the rover simulator's command-line front end.
 
-#include <CLI/CLI.hpp>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <iostream>
 #include <map>

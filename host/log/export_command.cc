@@ -56,11 +56,11 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
   std::optional<log::Ros2MsgSchema> parsed;
   try {
     parsed.emplace(log::Ros2MsgSchema::Parse(
-        schema.name, std::string_view(reinterpret_cast<const char*>(schema.data.data()),
-                                      schema.data.size())));
+        schema.name,
+        std::string_view(reinterpret_cast<const char*>(schema.data.data()), schema.data.size())));
   } catch (const log::SchemaError& e) {
-    err << "rover-log export: schema " << schema.name << " in " << options.path << ": "
-        << e.what() << "\n";
+    err << "rover-log export: schema " << schema.name << " in " << options.path << ": " << e.what()
+        << "\n";
     return 2;
   }
   const log::DynamicDecoder decoder(*parsed);
@@ -89,8 +89,8 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
       [&](const log::MessageView& m) {
         if (!decoder.Decode(m.data, &fields, &error)) {
           if (undecodable++ == 0) {
-            err << "rover-log export: message at log_time " << m.log_time
-                << " (sequence " << m.sequence << ") cannot be decoded: " << error << "\n";
+            err << "rover-log export: message at log_time " << m.log_time << " (sequence "
+                << m.sequence << ") cannot be decoded: " << error << "\n";
           }
           return true;
         }
@@ -110,7 +110,8 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
       [&](const log::MessageView& m) {
         if (!decoder.Decode(m.data, &fields, &error)) return true;  // reported above
         std::fill(row.begin(), row.end(), std::string());
-        for (const log::FlatField& f : fields) row[column_of.find(f.path)->second] = log::FormatValue(f);
+        for (const log::FlatField& f : fields)
+          row[column_of.find(f.path)->second] = log::FormatValue(f);
         *csv << m.log_time << "," << m.sequence;
         for (const std::string& cell : row) *csv << "," << CsvCell(cell);
         *csv << "\n";
@@ -119,8 +120,8 @@ int RunExport(const ExportOptions& options, std::ostream& out, std::ostream& err
       },
       read);
   csv->flush();
-  err << "rover-log export: " << rows << " rows of " << options.topic << " (" << schema.name
-      << ", " << columns.size() << " fields)";
+  err << "rover-log export: " << rows << " rows of " << options.topic << " (" << schema.name << ", "
+      << columns.size() << " fields)";
   if (undecodable > 0) err << "; " << undecodable << " undecodable message(s) skipped";
   err << "\n";
   if (!reader.damage().empty()) {

@@ -29,10 +29,10 @@ std::string CompressionLine(const std::vector<log::ChunkInfo>& chunks) {
     line += (line.empty() ? "" : ", ") + codec + " (" + std::to_string(n) + " chunks)";
   }
   char ratio[64];
-  std::snprintf(ratio, sizeof ratio, "; %s -> %s, ratio %.2f", FormatBytes(uncompressed).c_str(),
-                FormatBytes(compressed).c_str(),
-                compressed > 0 ? static_cast<double>(uncompressed) / static_cast<double>(compressed)
-                               : 0.0);
+  std::snprintf(
+      ratio, sizeof ratio, "; %s -> %s, ratio %.2f", FormatBytes(uncompressed).c_str(),
+      FormatBytes(compressed).c_str(),
+      compressed > 0 ? static_cast<double>(uncompressed) / static_cast<double>(compressed) : 0.0);
   return line + ratio;
 }
 
@@ -65,12 +65,13 @@ int RunInfo(const std::string& path, std::ostream& out, std::ostream& err) {
   }
 
   out << "file:         " << path << " (" << FormatBytes(reader.file_size()) << ")\n";
-  out << "profile:      " << reader.header().profile << "  (written by "
-      << reader.header().library << ")\n";
+  out << "profile:      " << reader.header().profile << "  (written by " << reader.header().library
+      << ")\n";
   out << "summary:      "
-      << (reader.summary_ok() ? "intact"
-                              : (reader.truncated() ? "missing: file truncated, data section scanned"
-                                                    : "unusable, data section scanned"))
+      << (reader.summary_ok()
+              ? "intact"
+              : (reader.truncated() ? "missing: file truncated, data section scanned"
+                                    : "unusable, data section scanned"))
       << "\n";
   out << "compression:  " << CompressionLine(reader.chunks()) << "\n";
   if (total > 0) {

@@ -20,8 +20,8 @@ int RunRecover(const std::string& in, const std::string& out_path,
       << " intact chunks into " << out_path << "\n";
   if (result.input_truncated) out << "input was truncated (no footer)\n";
   if (result.chunks_dropped > 0 || result.messages_dropped > 0) {
-    out << "lost: " << result.chunks_dropped << " damaged chunks, about "
-        << result.messages_dropped << " messages\n";
+    out << "lost: " << result.chunks_dropped << " damaged chunks, about " << result.messages_dropped
+        << " messages\n";
   }
   for (const log::Damage& d : result.dropped) {
     out << "  offset " << d.offset << ": " << d.what << "\n";

@@ -17,8 +17,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "rover-log 0.1.0");
 
   std::string path;
-  auto* info = app.add_subcommand("info", "Summarise a log: channels, message counts, rates, "
-                                          "time range, compression");
+  auto* info = app.add_subcommand("info",
+                                  "Summarise a log: channels, message counts, rates, "
+                                  "time range, compression");
   info->add_option("FILE", path, "flight log (.mcap)")->required()->check(CLI::ExistingFile);
 
   rover::host::ExportOptions export_options;

@@ -12,8 +12,8 @@ int RunVerify(const std::string& path, std::ostream& out, std::ostream& /*err*/)
   out << "  chunks:            " << report.chunk_count << " (" << report.damaged_chunk_count
       << " damaged)\n";
   out << "  schemas/channels:  " << report.schema_count << "/" << report.channel_count << "\n";
-  out << "  summary:           " << (report.summary_ok ? "intact, consistent" : "missing or invalid")
-      << "\n";
+  out << "  summary:           "
+      << (report.summary_ok ? "intact, consistent" : "missing or invalid") << "\n";
   out << "  truncated:         " << (report.truncated ? "yes" : "no") << "\n";
   for (const log::Damage& d : report.damage) {
     char offset[32];

@@ -74,7 +74,7 @@ sensor_msgs::Imu MakeImu(int i) {
 Expectations WriteLog(const std::string& path, Compression compression) {
   FlightLogOptions options;
   options.mcap.compression = compression;
-  options.mcap.chunk_size_bytes = 16 * 1024;  // many chunks, so indexes matter
+  options.mcap.chunk_size_bytes = 16 * 1024;        // many chunks, so indexes matter
   options.health_period = Duration::Seconds(3600);  // exactly one LogHealth, at Stop()
   FlightLog log(options);
   log.Open(path);
@@ -167,8 +167,7 @@ Expectations WriteLog(const std::string& path, Compression compression) {
   img.step = 6;
   for (int i = 0; i < 24; ++i) img.data.push_back(static_cast<uint8_t>(i * 10));
   EXPECT_TRUE(image->Log(StampOf(8), img));
-  e.Channel("/cam0/thumbnail", MessageTraits<sensor_msgs::Image>::kName, 1, StampOf(8),
-            StampOf(8));
+  e.Channel("/cam0/thumbnail", MessageTraits<sensor_msgs::Image>::kName, 1, StampOf(8), StampOf(8));
   std::string pixels = "[";
   for (int i = 0; i < 24; ++i) pixels += (i ? "," : "") + std::to_string(i * 10);
   e.Sample("/cam0/thumbnail", 0, StampOf(8),
@@ -215,9 +214,12 @@ INSTANTIATE_TEST_SUITE_P(Compressions, McapConformanceTest,
                                            Compression::kNone),
                          [](const auto& param_info) {
                            switch (param_info.param) {
-                             case Compression::kZstd: return std::string("zstd");
-                             case Compression::kLz4: return std::string("lz4");
-                             case Compression::kNone: return std::string("none");
+                             case Compression::kZstd:
+                               return std::string("zstd");
+                             case Compression::kLz4:
+                               return std::string("lz4");
+                             case Compression::kNone:
+                               return std::string("none");
                            }
                            return std::string("unknown");
                          });

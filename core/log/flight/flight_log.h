@@ -58,7 +58,8 @@ class FlightLog {
   /// as the FlightLog; one thread may log through it.
   template <RosMessage Msg, std::size_t kSlotBytes = 1024, std::size_t kSlots = 1024>
   LogChannel<Msg, kSlotBytes, kSlots>* AddChannel(const std::string& topic) {
-    const uint16_t schema_id = SchemaFor(MessageTraits<Msg>::kName, MessageTraits<Msg>::Definition());
+    const uint16_t schema_id =
+        SchemaFor(MessageTraits<Msg>::kName, MessageTraits<Msg>::Definition());
     auto channel = std::make_unique<LogChannel<Msg, kSlotBytes, kSlots>>(
         topic, writer_.AddChannel(schema_id, topic, kCdrMessageEncoding));
     auto* handle = channel.get();

@@ -24,9 +24,9 @@ namespace rover::log {
 
 /// Counters of one channel; safe to read from any thread (relaxed snapshot).
 struct LogChannelCounters {
-  uint64_t logged = 0;         ///< Log() calls
-  uint64_t written = 0;        ///< records handed to the MCAP writer
-  uint64_t dropped_full = 0;   ///< rejected because the ring was full
+  uint64_t logged = 0;            ///< Log() calls
+  uint64_t written = 0;           ///< records handed to the MCAP writer
+  uint64_t dropped_full = 0;      ///< rejected because the ring was full
   uint64_t dropped_oversize = 0;  ///< rejected because the serialised message exceeded a slot
   uint64_t ring_high_water = 0;   ///< most records ever queued at once
 };

@@ -35,7 +35,9 @@ bool IsSeparator(std::string_view line) {
   return line.size() >= 3 && line.find_first_not_of('=') == std::string_view::npos;
 }
 
-std::string PackageOf(const std::string& type_name) { return type_name.substr(0, type_name.find('/')); }
+std::string PackageOf(const std::string& type_name) {
+  return type_name.substr(0, type_name.find('/'));
+}
 
 const std::map<std::string_view, FieldKind>& PrimitiveKinds() {
   static const std::map<std::string_view, FieldKind> kinds = {
@@ -98,11 +100,11 @@ class Parser {
     }
     field->kind = FieldKind::kMessage;
     if (type == "time" || type == "duration") {  // ROS 1 spellings some tools still emit
-      field->type_name = type == "time" ? "builtin_interfaces/msg/Time"
-                                        : "builtin_interfaces/msg/Duration";
+      field->type_name =
+          type == "time" ? "builtin_interfaces/msg/Time" : "builtin_interfaces/msg/Duration";
     } else if (type.find('/') == std::string_view::npos) {
-      field->type_name = type == "Header" ? "std_msgs/msg/Header"
-                                          : PackageOf(type_) + "/msg/" + std::string(type);
+      field->type_name =
+          type == "Header" ? "std_msgs/msg/Header" : PackageOf(type_) + "/msg/" + std::string(type);
     } else {
       field->type_name = NormalizeTypeName(type);
     }
@@ -112,7 +114,8 @@ class Parser {
   // ("byte OK=0", "int32 X = 5"), which carry no data on the wire.
   bool ParseLine(std::string_view line, FieldDefinition* field) const {
     const auto type_end = line.find_first_of(" \t");
-    if (type_end == std::string_view::npos) Fail("expected 'type name', found '" + std::string(line) + "'");
+    if (type_end == std::string_view::npos)
+      Fail("expected 'type name', found '" + std::string(line) + "'");
     const std::string_view type = line.substr(0, type_end);
     std::string_view rest = Trim(line.substr(type_end));
     const auto name_end = rest.find_first_of(" \t=");

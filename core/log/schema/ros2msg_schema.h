@@ -23,8 +23,22 @@ class SchemaError : public std::runtime_error {
 
 /// The primitive kinds of ROS 2 IDL, plus kMessage for nested types.
 enum class FieldKind {
-  kBool, kByte, kChar, kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kInt64, kUint64,
-  kFloat32, kFloat64, kString, kWString, kMessage,
+  kBool,
+  kByte,
+  kChar,
+  kInt8,
+  kUint8,
+  kInt16,
+  kUint16,
+  kInt32,
+  kUint32,
+  kInt64,
+  kUint64,
+  kFloat32,
+  kFloat64,
+  kString,
+  kWString,
+  kMessage,
 };
 
 /// How many values a field holds.

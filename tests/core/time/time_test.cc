@@ -12,7 +12,9 @@ static_assert(std::is_trivially_copyable_v<Duration>);
 static_assert(sizeof(Time) == 8 && sizeof(Duration) == 8);
 // A point plus a point is meaningless and must not compile.
 template <typename A, typename B>
-concept Addable = requires(A a, B b) { a + b; };
+concept Addable = requires(A a, B b) {
+  a + b;
+};
 static_assert(!Addable<Time, Time>);
 static_assert(Addable<Time, Duration>);
 

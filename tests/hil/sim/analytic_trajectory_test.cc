@@ -67,9 +67,9 @@ TEST(ImuErrorModelTest, WhiteNoiseMatchesDensity) {
   const int n = 200000;
   double sum = 0.0, sum_sq = 0.0;
   for (int i = 0; i < n; ++i) {
-    const double x =
-        model.Apply(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), dt).angular_velocity_rad_s.x() -
-        model.gyro_bias_rad_s().x();
+    const double x = model.Apply(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), dt)
+                         .angular_velocity_rad_s.x() -
+                     model.gyro_bias_rad_s().x();
     sum += x;
     sum_sq += x * x;
   }

@@ -80,9 +80,9 @@ TEST(DynamicDecoderTest, EveryTruncationIsAnErrorNamingFieldAndOffset) {
   array.status[0].name = "camera";
   array.status[0].values = {{"k", "v"}};
   const std::vector<std::byte> bytes = SerializeMessage(array);
-  const Ros2MsgSchema schema = Ros2MsgSchema::Parse(
-      MessageTraits<diagnostic_msgs::DiagnosticArray>::kName,
-      MessageTraits<diagnostic_msgs::DiagnosticArray>::Definition());
+  const Ros2MsgSchema schema =
+      Ros2MsgSchema::Parse(MessageTraits<diagnostic_msgs::DiagnosticArray>::kName,
+                           MessageTraits<diagnostic_msgs::DiagnosticArray>::Definition());
   const DynamicDecoder decoder(schema);
   for (std::size_t n = 0; n < bytes.size(); ++n) {
     std::vector<FlatField> fields;

@@ -47,8 +47,8 @@ TEST(Ros2MsgSchemaTest, ParsesFieldsArraysAndDependencies) {
 }
 
 TEST(Ros2MsgSchemaTest, BuiltinTimeIsImplicit) {
-  const Ros2MsgSchema schema = Ros2MsgSchema::Parse(
-      "std_msgs/Header", "builtin_interfaces/Time stamp\nstring frame_id\n");
+  const Ros2MsgSchema schema =
+      Ros2MsgSchema::Parse("std_msgs/Header", "builtin_interfaces/Time stamp\nstring frame_id\n");
   const MessageDefinition& time = schema.Type("builtin_interfaces/msg/Time");
   ASSERT_EQ(time.fields.size(), 2u);
   EXPECT_EQ(time.fields[0].kind, FieldKind::kInt32);
