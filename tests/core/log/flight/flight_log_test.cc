@@ -13,16 +13,16 @@
 namespace rover::log {
 namespace {
 
+Time StampOf(int i) { return Time::FromNanoseconds(1'000'000'000 + int64_t{i} * 2'500'000); }
+
 sensor_msgs::Imu MakeImu(int i) {
   sensor_msgs::Imu imu;
-  imu.header.stamp = ToRosTime(Time::FromNanoseconds(1'000'000'000 + i * 2'500'000));
+  imu.header.stamp = ToRosTime(StampOf(i));
   imu.header.frame_id = "body";
   imu.angular_velocity.z = 0.001 * i;
   imu.linear_acceleration.z = 9.80665;
   return imu;
 }
-
-Time StampOf(int i) { return Time::FromNanoseconds(1'000'000'000 + int64_t{i} * 2'500'000); }
 
 // Reads every message of `topic` back, decoded as Msg, with its sequence.
 template <typename Msg>
