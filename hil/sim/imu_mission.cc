@@ -194,10 +194,11 @@ void PrintImuMissionSummary(const ImuMissionOptions& options, const ImuMissionRe
                 options.output_path.c_str(), static_cast<double>(r.file_bytes) / 1024.0,
                 static_cast<unsigned long long>(r.chunks));
   out << line;
-  std::snprintf(line, sizeof line,
-                "  Log() cost:       p50 %.0f ns, p99 %.0f ns, max %.0f ns (cold cache, one call per "
-                "tick; steady state: ./rover bench)\n",
-                r.log_call_ns_p50, r.log_call_ns_p99, r.log_call_ns_max);
+  std::snprintf(
+      line, sizeof line,
+      "  Log() cost:       p50 %.0f ns, p99 %.0f ns, max %.0f ns (cold cache, one call per "
+      "tick; steady state: ./rover bench)\n",
+      r.log_call_ns_p50, r.log_call_ns_p99, r.log_call_ns_max);
   out << line;
   if (!options.lockstep) {
     std::snprintf(line, sizeof line, "  loop lateness:    p99 %.1f us\n", r.tick_lateness_us_p99);
