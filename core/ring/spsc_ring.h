@@ -154,9 +154,7 @@ class SpscRing {
   /// sensor tick) calls this after CommitPush() so the next push finds its
   /// cache lines local instead of in the consumer's cache. Only a hint: it
   /// never faults, blocks or changes the ring.
-  void PrefetchNextPush(std::size_t bytes) const
-    requires(kRejects)
-  {
+  void PrefetchNextPush(std::size_t bytes) const requires(kRejects) {
     const auto* slot = slots_[head_.load(std::memory_order_relaxed) & kMask].bytes;
     const std::size_t n = std::min(bytes, sizeof(T));
     for (std::size_t offset = 0; offset < n; offset += kLine) {

@@ -130,7 +130,7 @@ class LogChannel final : public LogChannelBase {
  private:
   Ring ring_;
   std::array<std::byte, kSlotBytes> scratch_;  // producer-owned serialisation buffer
-  uint32_t next_sequence_ = 0;  // producer-owned; gaps in the file mark drops
+  uint32_t next_sequence_ = 0;                 // producer-owned; gaps in the file mark drops
   std::atomic<uint64_t> logged_{0};
   std::atomic<uint64_t> dropped_oversize_{0};
 };
