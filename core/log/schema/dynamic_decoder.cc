@@ -118,7 +118,7 @@ DynamicDecoder::DynamicDecoder(const Ros2MsgSchema& schema, DynamicDecoderOption
     : schema_(schema), options_(options) {}
 
 bool DynamicDecoder::Decode(std::span<const std::byte> cdr, std::vector<FlatField>* out,
-                            std::string* error) const {
+                            std::string* error, std::size_t* consumed_bytes) const {
   out->clear();
   CdrReader reader(cdr, schema_.root().name);
   if (reader.ok()) DecodeMessage(reader, schema_.root(), "", out);
@@ -126,6 +126,7 @@ bool DynamicDecoder::Decode(std::span<const std::byte> cdr, std::vector<FlatFiel
     if (error != nullptr) *error = reader.error();
     return false;
   }
+  if (consumed_bytes != nullptr) *consumed_bytes = reader.offset();
   return true;
 }
 

@@ -43,8 +43,10 @@ class DynamicDecoder {
   /// Decodes one serialized message (with its 4-byte encapsulation header)
   /// into `out` (cleared first). Returns false and sets `error` to a message
   /// naming the field and byte offset if the bytes do not match the schema.
-  bool Decode(std::span<const std::byte> cdr, std::vector<FlatField>* out,
-              std::string* error) const;
+  /// `consumed_bytes`, if given, receives how many bytes the message took;
+  /// fewer than `cdr.size()` hints at a schema that does not match the data.
+  bool Decode(std::span<const std::byte> cdr, std::vector<FlatField>* out, std::string* error,
+              std::size_t* consumed_bytes = nullptr) const;
 
  private:
   bool DecodeMessage(CdrReader& reader, const MessageDefinition& type, const std::string& prefix,
