@@ -31,6 +31,12 @@ DEBIAN_PACKAGES=(
   iceoryx                    # iox-roudi, the shared-memory broker
   libiceoryx-posh-dev        # iceoryx publish/subscribe API (core/ipc)
   nodejs                     # independent MCAP reader for conformance tests
+  libopencv-dev              # simulator image effects/distortion, SGBM check; later VO and depth
+  libapriltag-dev            # AprilTag 36h11 family: rendered tags, detection checks
+  libegl-dev                 # headless OpenGL context for the stereo renderer (EGL)
+  libgl-dev                  # OpenGL API used by the renderer
+  libegl-mesa0               # Mesa's EGL driver (surfaceless platform, no display needed)
+  libgl1-mesa-dri            # Mesa's llvmpipe software rasteriser: renders without a GPU
 )
 
 SUDO=""
