@@ -2,10 +2,9 @@
 
 #include <cmath>
 
+#include "hil/sim/motion/euler_rates.h"
+
 namespace rover::sim {
-namespace {
-constexpr double kGravity_m_s2 = 9.80665;
-}
 
 TrajectorySample AnalyticTrajectory::Evaluate(double t_s) const {
   const auto& o = options_;
@@ -15,27 +14,34 @@ TrajectorySample AnalyticTrajectory::Evaluate(double t_s) const {
   const double ca = std::cos(wa * t_s), sa = std::sin(wa * t_s);
 
   TrajectorySample out;
-  out.p_local_body = {o.radius_m * s, o.radius_m * (1.0 - c), o.heave_amplitude_m * sa};
-  out.v_local_body_m_s = {o.radius_m * w * c, o.radius_m * w * s, o.heave_amplitude_m * wa * ca};
-  const Eigen::Vector3d a_local_m_s2(-o.radius_m * w * w * s, o.radius_m * w * w * c,
-                                     -o.heave_amplitude_m * wa * wa * sa);
+  out.t_s = t_s;
+  out.p_world_body = {o.radius_m * s, o.radius_m * (1.0 - c), o.heave_amplitude_m * sa};
+  out.v_world_m_s = {o.radius_m * w * c, o.radius_m * w * s, o.heave_amplitude_m * wa * ca};
+  out.a_world_m_s2 = {-o.radius_m * w * w * s, o.radius_m * w * w * c,
+                      -o.heave_amplitude_m * wa * wa * sa};
 
   // Z-Y-X Euler angles and their rates; the heading follows the circuit.
   const double yaw = w * t_s, yaw_rate = w;
   const double pitch = o.pitch_amplitude_rad * sa, pitch_rate = o.pitch_amplitude_rad * wa * ca;
   const double roll = o.roll_amplitude_rad * ca, roll_rate = -o.roll_amplitude_rad * wa * sa;
-  const Eigen::Matrix3d R_local_body = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+  const Eigen::Matrix3d R_world_body = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
                                         Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
                                         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
                                            .toRotationMatrix();
-  out.q_local_body = Eigen::Quaterniond(R_local_body);
-  // Body rates from Z-Y-X Euler rates (exact kinematic relation).
-  const double sr = std::sin(roll), cr = std::cos(roll);
-  const double sp = std::sin(pitch), cp = std::cos(pitch);
-  out.omega_body_rad_s = {roll_rate - yaw_rate * sp, pitch_rate * cr + yaw_rate * cp * sr,
-                          -pitch_rate * sr + yaw_rate * cp * cr};
-  const Eigen::Vector3d g_local_m_s2(0.0, 0.0, -kGravity_m_s2);
-  out.specific_force_body_m_s2 = R_local_body.transpose() * (a_local_m_s2 - g_local_m_s2);
+  out.q_world_body = Eigen::Quaterniond(R_world_body);
+  EulerZyxJet euler;
+  euler.roll = roll;
+  euler.pitch = pitch;
+  euler.yaw = yaw;
+  euler.roll_rate = roll_rate;
+  euler.pitch_rate = pitch_rate;
+  euler.yaw_rate = yaw_rate;
+  euler.roll_accel = -o.roll_amplitude_rad * wa * wa * ca;
+  euler.pitch_accel = -o.pitch_amplitude_rad * wa * wa * sa;
+  out.omega_body_rad_s = BodyRates_rad_s(euler);
+  out.alpha_body_rad_s2 = BodyAngularAcceleration_rad_s2(euler);
+  out.specific_force_body_m_s2 =
+      R_world_body.transpose() * (out.a_world_m_s2 - GravityWorld_m_s2());
   return out;
 }
 

@@ -4,13 +4,13 @@
 // A smooth closed-form rover trajectory: a circuit at constant speed with
 // terrain-like roll and pitch oscillations. Every derivative is analytic, so
 // angular rate and specific force are exact, not finite differences. It is
-// the motion source of the early mission slice, until the terrain simulator
-// drives poses from wheel contact.
+// a reference motion for sensor-model tests (RoverTrajectory is the
+// terrain-driven motion of the simulator).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "core/time/time.h"
+#include "hil/sim/motion/trajectory_sample.h"
 
 namespace rover::sim {
 
@@ -24,21 +24,12 @@ struct AnalyticTrajectoryOptions {
   double heave_amplitude_m = 0.05;
 };
 
-/// Ground truth at one instant, in the gravity-aligned local frame (z up).
-struct TrajectorySample {
-  Eigen::Vector3d p_local_body;
-  Eigen::Vector3d v_local_body_m_s;
-  Eigen::Quaterniond q_local_body;
-  Eigen::Vector3d omega_body_rad_s;          ///< angular rate, body axes
-  Eigen::Vector3d specific_force_body_m_s2;  ///< what an ideal accelerometer measures
-};
-
-class AnalyticTrajectory {
+class AnalyticTrajectory : public MotionSource {
  public:
   explicit AnalyticTrajectory(const AnalyticTrajectoryOptions& options) : options_(options) {}
 
   /// Exact state at `t` seconds after the start of the trajectory.
-  TrajectorySample Evaluate(double t_s) const;
+  TrajectorySample Evaluate(double t_s) const override;
 
  private:
   AnalyticTrajectoryOptions options_;

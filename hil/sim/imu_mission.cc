@@ -13,6 +13,7 @@
 
 #include "core/log/flight/flight_log.h"
 #include "core/log/msgs/all_msgs.h"
+#include "hil/sim/world/world.h"
 
 namespace rover::sim {
 namespace {
@@ -44,17 +45,17 @@ double Percentile(std::vector<double> v, double p) {
   return v[k];
 }
 
-log::sensor_msgs::Imu MakeImuMessage(Time stamp, const ImuMeasurement& m,
-                                     const ImuErrorOptions& errors, double dt_s) {
+log::sensor_msgs::Imu MakeImuMessage(const drivers::ImuSample& m, const ImuModelOptions& imu) {
   log::sensor_msgs::Imu msg;
-  msg.header.stamp = log::ToRosTime(stamp);
+  msg.header.stamp = log::ToRosTime(m.stamp);
   msg.header.frame_id = "body";
   // No orientation estimate: ROS marks that with covariance[0] = -1.
   msg.orientation_covariance[0] = -1.0;
   msg.angular_velocity = ToVector3(m.angular_velocity_rad_s);
   msg.linear_acceleration = ToVector3(m.linear_acceleration_m_s2);
-  const double gyro_var = std::pow(errors.gyro_noise_density_rad_s_sqrt_hz, 2) / dt_s;
-  const double accel_var = std::pow(errors.accel_noise_density_m_s2_sqrt_hz, 2) / dt_s;
+  // Discrete white-noise variance of the densities at the sample rate.
+  const double gyro_var = std::pow(imu.gyro.noise_density, 2) * imu.rate_hz;
+  const double accel_var = std::pow(imu.accel.noise_density, 2) * imu.rate_hz;
   for (int i = 0; i < 3; ++i) {
     msg.angular_velocity_covariance[static_cast<std::size_t>(4 * i)] = gyro_var;
     msg.linear_acceleration_covariance[static_cast<std::size_t>(4 * i)] = accel_var;
@@ -65,19 +66,34 @@ log::sensor_msgs::Imu MakeImuMessage(Time stamp, const ImuMeasurement& m,
 log::nav_msgs::Odometry MakeGroundTruth(Time stamp, const TrajectorySample& s) {
   log::nav_msgs::Odometry msg;
   msg.header.stamp = log::ToRosTime(stamp);
-  msg.header.frame_id = "local/rover1/0";
+  msg.header.frame_id = "world";
   msg.child_frame_id = "body";
-  msg.pose.pose.position = {s.p_local_body.x(), s.p_local_body.y(), s.p_local_body.z()};
+  msg.pose.pose.position = {s.p_world_body.x(), s.p_world_body.y(), s.p_world_body.z()};
   msg.pose.pose.orientation =
-      Quaternion{s.q_local_body.x(), s.q_local_body.y(), s.q_local_body.z(), s.q_local_body.w()};
+      Quaternion{s.q_world_body.x(), s.q_world_body.y(), s.q_world_body.z(), s.q_world_body.w()};
   // Twist is expressed in the child frame (body), as nav_msgs/Odometry specifies.
-  const Eigen::Vector3d v_body = s.q_local_body.conjugate() * s.v_local_body_m_s;
+  const Eigen::Vector3d v_body = s.q_world_body.conjugate() * s.v_world_m_s;
   msg.twist.twist.linear = ToVector3(v_body);
   msg.twist.twist.angular = ToVector3(s.omega_body_rad_s);
   return msg;
 }
 
+// Enough survey laps to fill the mission: one lap is planned first to learn
+// its duration.
+RoverTrajectory PlanMission(const ImuMissionOptions& options, const Heightfield& terrain) {
+  const Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  const Route lap = MakeSurveyLoopRoute(center, options.loop_size_x_m, options.loop_size_y_m, 1);
+  const double lap_s = RoverTrajectory(lap, terrain, options.motion).duration_s() -
+                       lap.start_hold_s - lap.end_hold_s;
+  const int laps = std::max(1, static_cast<int>(std::ceil(options.duration_s / lap_s)));
+  return RoverTrajectory(
+      MakeSurveyLoopRoute(center, options.loop_size_x_m, options.loop_size_y_m, laps), terrain,
+      options.motion);
+}
+
 }  // namespace
+
+std::string DefaultImuConfigPath() { return std::string(ROVER_HIL_CONFIG_DIR) + "/imu_mti10.yaml"; }
 
 ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& status) {
   ImuMissionResult result;
@@ -88,40 +104,54 @@ ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& s
   flight_log.Open(options.output_path);
   auto* imu_channel = flight_log.AddChannel<log::sensor_msgs::Imu>("/imu");
   auto* truth_channel = flight_log.AddChannel<log::nav_msgs::Odometry>("/sim/ground_truth");
+  const double rate_hz = options.imu.rate_hz;
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", options.imu_rate_hz);
-  flight_log.WriteMetadata("mission", {{"scenario", "imu-circuit"},
+  std::snprintf(buf, sizeof buf, "%.17g", rate_hz);
+  flight_log.WriteMetadata("mission", {{"scenario", "imu-terrain-loop"},
+                                       {"imu_model", options.imu.model},
                                        {"imu_rate_hz", buf},
-                                       {"seed", std::to_string(options.imu_errors.seed)}});
+                                       {"seed", std::to_string(options.imu.seed)},
+                                       {"terrain_seed", std::to_string(options.terrain_seed)}});
 
-  const double dt_s = 1.0 / options.imu_rate_hz;
-  const Duration dt = Duration::FromSeconds(dt_s);
-  const auto samples =
-      static_cast<uint64_t>(std::llround(options.duration_s * options.imu_rate_hz));
+  // A gentle site without obstacles: the survey loop drives straight over it.
+  WorldOptions world_options;
+  world_options.size_m = options.terrain_size_m;
+  world_options.max_slope_deg = 12.0;
+  world_options.rock_count = 0;
+  world_options.crater_count = 0;
+  world_options.landmark_post_count = 0;
+  const World world = World::Generate(world_options, options.terrain_seed);
+  const RoverTrajectory trajectory = PlanMission(options, world.terrain);
+
+  const auto samples = static_cast<uint64_t>(std::llround(options.duration_s * rate_hz));
   const auto truth_every = std::max<uint64_t>(
-      1, static_cast<uint64_t>(std::llround(options.imu_rate_hz / options.ground_truth_rate_hz)));
+      1, static_cast<uint64_t>(std::llround(rate_hz / options.ground_truth_rate_hz)));
   // Preallocated so the loop itself never allocates.
   std::vector<double> log_cost_ns(samples), lateness_us(options.lockstep ? 0 : samples);
   std::atomic<uint64_t> done{0};
   std::atomic<bool> realtime{false};
-  const AnalyticTrajectory trajectory(options.trajectory);
-  ImuErrorModel imu_errors(options.imu_errors);
+  double distance_m = 0.0;
 
   flight_log.Start();
   const Time wall_start = Time::Now();
   const Time t0 = wall_start + Duration::Milliseconds(10);
+  ImuModel imu(options.imu, t0);
   std::thread imu_thread([&] {
     realtime.store(TrySetFifoPriority(options.imu_thread_priority));
+    Eigen::Vector2d last_xy = trajectory.Evaluate(0.0).p_world_body.head<2>();
     for (uint64_t k = 0; k < samples; ++k) {
-      const Time stamp = t0 + dt * static_cast<int64_t>(k);
+      // The sample (and its jittered stamp) is computed ahead, then released
+      // at its stamp, as a device would deliver it.
+      TrajectorySample truth;
+      const drivers::ImuSample m = imu.Next(trajectory, &truth);
+      const Time stamp = m.stamp;
       if (!options.lockstep) {
         SleepUntil(stamp);
         lateness_us[k] = (Time::Now() - stamp).ToMicroseconds();
       }
-      const TrajectorySample truth = trajectory.Evaluate(static_cast<double>(k) * dt_s);
-      const ImuMeasurement m =
-          imu_errors.Apply(truth.omega_body_rad_s, truth.specific_force_body_m_s2, dt_s);
-      const auto msg = MakeImuMessage(stamp, m, options.imu_errors, dt_s);
+      distance_m += (truth.p_world_body.head<2>() - last_xy).norm();
+      last_xy = truth.p_world_body.head<2>();
+      const auto msg = MakeImuMessage(m, options.imu);
       const Time before = Time::Now();
       imu_channel->Log(stamp, msg);
       log_cost_ns[k] = static_cast<double>((Time::Now() - before).nanoseconds());
@@ -165,7 +195,7 @@ ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& s
   result.chunks = s.mcap.chunks;
   result.error = s.error;
   result.wall_time_s = (Time::Now() - wall_start).ToSeconds();
-  result.distance_m = options.trajectory.speed_m_s * options.duration_s;
+  result.distance_m = distance_m;
   result.realtime_priority = realtime.load();
   result.log_call_ns_p50 = Percentile(log_cost_ns, 0.5);
   result.log_call_ns_p99 = Percentile(log_cost_ns, 0.99);
@@ -178,9 +208,11 @@ ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& s
 void PrintImuMissionSummary(const ImuMissionOptions& options, const ImuMissionResult& r,
                             std::ostream& out) {
   char line[256];
-  out << "mission summary (imu-circuit)\n";
+  out << "mission summary (imu-terrain-loop)\n";
   std::snprintf(line, sizeof line, "  simulated:        %.1f s at %.0f Hz, %.1f m driven\n",
-                options.duration_s, options.imu_rate_hz, r.distance_m);
+                options.duration_s, options.imu.rate_hz, r.distance_m);
+  out << line;
+  std::snprintf(line, sizeof line, "  imu model:        %s\n", options.imu.model.c_str());
   out << line;
   std::snprintf(line, sizeof line, "  imu thread:       %s\n",
                 r.realtime_priority ? "SCHED_FIFO" : "normal priority (no real-time privilege)");

@@ -1,25 +1,25 @@
 #ifndef ROVER_HIL_SIM_IMU_MISSION_H_
 #define ROVER_HIL_SIM_IMU_MISSION_H_
 
-// The early mission slice: a simulated IMU thread drives the real-time
-// flight-log path (LogChannel::Log from a paced loop) while the writer thread
-// produces a crash-safe MCAP file. It stands in for roverd until the
-// estimator and the full simulator land.
+// The early mission slice: the simulated rover drives survey loops over a
+// generated terrain, and a simulated IMU thread samples it and drives the
+// real-time flight-log path (LogChannel::Log from a paced loop) while the
+// writer thread produces a crash-safe MCAP file. It stands in for roverd
+// until the estimator and the full simulator land.
 
 #include <cstdint>
 #include <ostream>
 #include <string>
 
 #include "core/log/mcap/compression.h"
-#include "hil/sim/analytic_trajectory.h"
-#include "hil/sim/imu_error_model.h"
+#include "hil/sim/motion/rover_trajectory.h"
+#include "hil/sim/sensors/imu_model.h"
 
 namespace rover::sim {
 
 struct ImuMissionOptions {
   std::string output_path = "mission.mcap";
   double duration_s = 60.0;
-  double imu_rate_hz = 400.0;
   double ground_truth_rate_hz = 50.0;
   /// Real time paces the loop with clock_nanosleep; lockstep runs as fast as
   /// possible with simulated timestamps (same output for the same seed).
@@ -30,9 +30,17 @@ struct ImuMissionOptions {
   bool status_in_place = false;
   log::Compression compression = log::Compression::kZstd;
   int zstd_level = 1;
-  AnalyticTrajectoryOptions trajectory;
-  ImuErrorOptions imu_errors;
+  /// IMU rate and errors; rover-sim loads them from DefaultImuConfigPath().
+  ImuModelOptions imu;
+  RoverTrajectoryOptions motion;
+  uint64_t terrain_seed = 1;
+  double terrain_size_m = 32.0;  ///< side of the generated square site
+  double loop_size_x_m = 10.0;   ///< survey rectangle, centred on the site
+  double loop_size_y_m = 6.0;
 };
+
+/// The MTi-10-class IMU parameter file shipped in hil/config/.
+std::string DefaultImuConfigPath();
 
 /// What the mission did, for the summary.
 struct ImuMissionResult {

@@ -3,10 +3,83 @@
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <iostream>
 #include <map>
 
+#include <cstdio>
+#include <filesystem>
+
+#include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/imu_mission.h"
+#include "hil/sim/scenario/scenario.h"
+
+namespace {
+
+int RunList(std::ostream& out) {
+  const std::string dir = rover::sim::DefaultScenarioDir();
+  const auto files = rover::sim::ListScenarioFiles(dir);
+  if (files.empty()) {
+    std::cerr << "rover-sim list: no scenarios in " << dir << " (set ROVER_SCENARIO_DIR)\n";
+    return 1;
+  }
+  for (const std::string& file : files) {
+    const rover::sim::Scenario s =
+        rover::sim::LoadScenario(file, rover::sim::DefaultSimConfigDir());
+    char line[256];
+    std::snprintf(line, sizeof line, "%-12s %s\n", s.name.c_str(), s.description.c_str());
+    out << line;
+  }
+  return 0;
+}
+
+struct GenerateArgs {
+  std::string scenario;
+  uint64_t seed = 1;
+  std::string out_dir;
+  double max_duration_s = 0.0;
+};
+
+int RunGenerate(const GenerateArgs& args) {
+  const std::string path =
+      rover::sim::FindScenario(rover::sim::DefaultScenarioDir(), args.scenario);
+  const rover::sim::Scenario scenario =
+      rover::sim::LoadScenario(path, rover::sim::DefaultSimConfigDir());
+  rover::sim::GenerateOptions options;
+  options.seed = args.seed;
+  options.out_dir = args.out_dir;
+  options.max_duration_s = args.max_duration_s;
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  const rover::Time start = rover::Time::Now();
+  int last_decile = -1;
+  options.progress = [&](double fraction, double sim_time_s) {
+    const double elapsed_s = (rover::Time::Now() - start).ToSeconds();
+    const double eta_s = fraction > 0 ? elapsed_s * (1.0 - fraction) / fraction : 0.0;
+    const int decile = static_cast<int>(fraction * 10.0);
+    if (!tty && decile == last_decile) return;
+    last_decile = decile;
+    std::fprintf(stderr, "%s[%3.0f%%] sim %7.1f s, wall %6.1f s, ETA %5.0f s%s", tty ? "\r" : "",
+                 100.0 * fraction, sim_time_s, elapsed_s, eta_s, tty ? "" : "\n");
+  };
+  std::cerr << "rover-sim: generating '" << scenario.name << "' (seed " << args.seed << ") into "
+            << args.out_dir << "\n";
+  const rover::sim::GenerateResult r = rover::sim::GenerateDataset(scenario, options);
+  if (tty) std::cerr << "\n";
+  std::printf(
+      "dataset %s\n  scenario:    %s, seed %llu\n  simulated:   %.1f s, %.1f m driven\n"
+      "  imu:         %llu samples\n  stereo:      %llu pairs (%s)\n  can:         %llu frames\n"
+      "  gpio:        %llu edges\n  wall time:   %.1f s (world %.1f s, render %.1f s, write "
+      "%.1f s), %.2fx real time\n",
+      args.out_dir.c_str(), scenario.name.c_str(), static_cast<unsigned long long>(args.seed),
+      r.sim_duration_s, r.distance_m, static_cast<unsigned long long>(r.imu_samples),
+      static_cast<unsigned long long>(r.stereo_frames), r.gl_renderer.c_str(),
+      static_cast<unsigned long long>(r.can_frames), static_cast<unsigned long long>(r.gpio_edges),
+      r.wall_time_s, r.world_time_s, r.render_time_s, r.write_time_s,
+      r.sim_duration_s / std::max(r.wall_time_s, 1e-9));
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -16,19 +89,26 @@ int main(int argc, char** argv) {
 
   rover::sim::ImuMissionOptions options;
   std::string compression = "zstd";
+  std::string imu_config = rover::sim::DefaultImuConfigPath();
+  double imu_rate_hz = 0.0;
+  uint64_t imu_seed = 0;
   auto* imu = app.add_subcommand(
       "imu",
-      "Drive a circuit with a simulated IMU at a real-time-paced thread and log it to MCAP\n"
-      "(raw IMU on /imu, ground truth on /sim/ground_truth, log health on /rover/log_health)");
+      "Drive survey loops over a generated terrain with a simulated IMU at a real-time-paced\n"
+      "thread and log it to MCAP (raw IMU on /imu, ground truth on /sim/ground_truth, log\n"
+      "health on /rover/log_health)");
   imu->add_option("--out", options.output_path, "flight log to write (.mcap)")
       ->capture_default_str();
   imu->add_option("--duration-s", options.duration_s, "simulated time [s]")
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
-  imu->add_option("--rate-hz", options.imu_rate_hz, "IMU sample rate [Hz]")
-      ->check(CLI::Range(100.0, 1000.0))
-      ->capture_default_str();
-  imu->add_option("--seed", options.imu_errors.seed, "seed of the IMU error model")
+  imu->add_option("--imu-config", imu_config, "IMU parameter file (YAML)")->capture_default_str();
+  auto* rate_option =
+      imu->add_option("--rate-hz", imu_rate_hz, "IMU sample rate [Hz] (default: the config's)")
+          ->check(CLI::Range(100.0, 1000.0));
+  auto* seed_option =
+      imu->add_option("--seed", imu_seed, "seed of the IMU error model (default: the config's)");
+  imu->add_option("--terrain-seed", options.terrain_seed, "seed of the generated terrain")
       ->capture_default_str();
   imu->add_flag("--lockstep", options.lockstep,
                 "run as fast as possible with simulated timestamps instead of real time");
@@ -40,7 +120,34 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->capture_default_str();
 
+  auto* list = app.add_subcommand("list", "Print the scenarios that `generate` accepts");
+
+  GenerateArgs generate_args;
+  auto* generate = app.add_subcommand(
+      "generate",
+      "Write a scenario as an EuRoC-layout dataset (IMU, stereo PNGs, ground truth, sensor.yaml,\n"
+      "plus depth, wheel odometry, CAN frames, GPIO edges, tag poses and the world's ground "
+      "truth)");
+  generate->add_option("--scenario", generate_args.scenario, "scenario name (see `rover-sim list`)")
+      ->required();
+  generate->add_option("--seed", generate_args.seed, "world and sensor noise seed")
+      ->capture_default_str();
+  generate->add_option("--out", generate_args.out_dir, "output folder (must not hold a mav0/)")
+      ->required();
+  generate
+      ->add_option("--max-duration-s", generate_args.max_duration_s,
+                   "stop after this much simulated time (default: the whole route)")
+      ->check(CLI::PositiveNumber);
+
   CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (*list) return RunList(std::cout);
+    if (*generate) return RunGenerate(generate_args);
+  } catch (const std::exception& e) {
+    std::cerr << "rover-sim: " << e.what() << "\n";
+    return 2;
+  }
 
   static const std::map<std::string, rover::log::Compression> kCodecs = {
       {"zstd", rover::log::Compression::kZstd},
@@ -49,6 +156,9 @@ int main(int argc, char** argv) {
   options.compression = kCodecs.at(compression);
   options.status_in_place = isatty(STDERR_FILENO) != 0;
   try {
+    options.imu = rover::sim::ImuModelOptions::LoadFile(imu_config);
+    if (rate_option->count() > 0) options.imu.rate_hz = imu_rate_hz;
+    if (seed_option->count() > 0) options.imu.seed = imu_seed;
     const rover::sim::ImuMissionResult result = rover::sim::RunImuMission(options, std::cerr);
     if (!result.realtime_priority && options.imu_thread_priority > 0) {
       std::cerr << "rover-sim: no permission for SCHED_FIFO " << options.imu_thread_priority

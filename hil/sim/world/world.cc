@@ -2,8 +2,8 @@
 // roughness, a crater, rocks), landmark posts and other rovers, albedo.
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>

@@ -4,8 +4,6 @@
 
 #include <Eigen/Geometry>
 
-#include "hil/sim/imu_error_model.h"
-
 namespace rover::sim {
 namespace {
 
@@ -18,18 +16,23 @@ TEST(AnalyticTrajectoryTest, RatesMatchNumericDerivatives) {
     const TrajectorySample now = trajectory.Evaluate(t);
     const TrajectorySample before = trajectory.Evaluate(t - h);
     const TrajectorySample after = trajectory.Evaluate(t + h);
-    const Eigen::Vector3d v_numeric = (after.p_local_body - before.p_local_body) / (2 * h);
-    EXPECT_LT((v_numeric - now.v_local_body_m_s).norm(), 1e-7) << "t=" << t;
+    const Eigen::Vector3d v_numeric = (after.p_world_body - before.p_world_body) / (2 * h);
+    EXPECT_LT((v_numeric - now.v_world_m_s).norm(), 1e-7) << "t=" << t;
 
-    const Eigen::Quaterniond dq = before.q_local_body.conjugate() * after.q_local_body;
+    const Eigen::Quaterniond dq = before.q_world_body.conjugate() * after.q_world_body;
     const Eigen::AngleAxisd aa(dq);
     const Eigen::Vector3d omega_numeric = aa.angle() * aa.axis() / (2 * h);
     EXPECT_LT((omega_numeric - now.omega_body_rad_s).norm(), 1e-7) << "t=" << t;
 
-    const Eigen::Vector3d a_numeric = (after.v_local_body_m_s - before.v_local_body_m_s) / (2 * h);
+    const Eigen::Vector3d a_numeric = (after.v_world_m_s - before.v_world_m_s) / (2 * h);
     const Eigen::Vector3d f_numeric =
-        now.q_local_body.conjugate() * (a_numeric + Eigen::Vector3d(0, 0, 9.80665));
+        now.q_world_body.conjugate() * (a_numeric + Eigen::Vector3d(0, 0, 9.80665));
     EXPECT_LT((f_numeric - now.specific_force_body_m_s2).norm(), 1e-6) << "t=" << t;
+    EXPECT_LT((a_numeric - now.a_world_m_s2).norm(), 1e-6) << "t=" << t;
+
+    const Eigen::Vector3d alpha_numeric =
+        (after.omega_body_rad_s - before.omega_body_rad_s) / (2 * h);
+    EXPECT_LT((alpha_numeric - now.alpha_body_rad_s2).norm(), 1e-6) << "t=" << t;
   }
 }
 
@@ -37,47 +40,7 @@ TEST(AnalyticTrajectoryTest, DrivesAtConfiguredSpeed) {
   AnalyticTrajectoryOptions options;
   options.heave_amplitude_m = 0.0;
   const AnalyticTrajectory trajectory(options);
-  EXPECT_NEAR(trajectory.Evaluate(3.0).v_local_body_m_s.norm(), options.speed_m_s, 1e-12);
-}
-
-TEST(ImuErrorModelTest, SameSeedSameStream) {
-  ImuErrorModel a(ImuErrorOptions{}), b(ImuErrorOptions{});
-  ImuErrorOptions other;
-  other.seed = 2;
-  ImuErrorModel c(other);
-  const Eigen::Vector3d w(0.1, 0.2, 0.3), f(0, 0, 9.8);
-  bool differs = false;
-  for (int i = 0; i < 100; ++i) {
-    const ImuMeasurement ma = a.Apply(w, f, 0.0025), mb = b.Apply(w, f, 0.0025);
-    const ImuMeasurement mc = c.Apply(w, f, 0.0025);
-    ASSERT_EQ(ma.angular_velocity_rad_s, mb.angular_velocity_rad_s);
-    ASSERT_EQ(ma.linear_acceleration_m_s2, mb.linear_acceleration_m_s2);
-    differs |= ma.angular_velocity_rad_s != mc.angular_velocity_rad_s;
-  }
-  EXPECT_TRUE(differs);
-}
-
-// The discrete white noise must have sigma = density / sqrt(dt).
-TEST(ImuErrorModelTest, WhiteNoiseMatchesDensity) {
-  ImuErrorOptions options;
-  options.gyro_bias_random_walk_rad_s2_sqrt_hz = 0.0;
-  options.accel_bias_random_walk_m_s3_sqrt_hz = 0.0;
-  ImuErrorModel model(options);
-  const double dt = 1.0 / 400.0;
-  const int n = 200000;
-  double sum = 0.0, sum_sq = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double x = model.Apply(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), dt)
-                         .angular_velocity_rad_s.x() -
-                     model.gyro_bias_rad_s().x();
-    sum += x;
-    sum_sq += x * x;
-  }
-  const double mean = sum / n;
-  const double sigma = std::sqrt(sum_sq / n - mean * mean);
-  const double expected = options.gyro_noise_density_rad_s_sqrt_hz / std::sqrt(dt);
-  EXPECT_NEAR(sigma / expected, 1.0, 0.01);
-  EXPECT_NEAR(mean, 0.0, 4.0 * expected / std::sqrt(n));
+  EXPECT_NEAR(trajectory.Evaluate(3.0).v_world_m_s.norm(), options.speed_m_s, 1e-12);
 }
 
 }  // namespace
