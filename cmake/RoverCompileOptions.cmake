@@ -22,6 +22,15 @@ function(rover_target_defaults target)
   target_link_libraries(${target} PRIVATE rover_warnings)
 endfunction()
 
+# Shared reference data (EuRoC excerpt, pose graphs) lives beside the
+# checkout; $ROVER_SHARED_DIR overrides where.
+if(DEFINED ENV{ROVER_SHARED_DIR})
+  set(ROVER_SHARED_DIR "$ENV{ROVER_SHARED_DIR}" CACHE PATH "shared reference data")
+else()
+  get_filename_component(_shared "${PROJECT_SOURCE_DIR}/../shared" ABSOLUTE)
+  set(ROVER_SHARED_DIR "${_shared}" CACHE PATH "shared reference data")
+endif()
+
 # rover_add_test(NAME name SOURCES a.cc b.cc LIBS libs... [LABELS l...] [RESOURCE_LOCK r])
 # One gtest executable, registered test-by-test with ctest. Labels select the
 # sanitizer runs (asan, tsan); RESOURCE_LOCK serialises tests sharing one
@@ -36,8 +45,7 @@ function(rover_add_test)
   rover_target_defaults(${ARG_NAME})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LIBS} GTest::gmock GTest::gtest_main)
   gtest_discover_tests(${ARG_NAME} TEST_LIST ${ARG_NAME}_TESTS DISCOVERY_TIMEOUT 60)
-  set(environment
-      "ROVER_SOURCE_DIR=${PROJECT_SOURCE_DIR};ROVER_SHARED_DIR=${PROJECT_SOURCE_DIR}/../shared")
+  set(environment "ROVER_SOURCE_DIR=${PROJECT_SOURCE_DIR};ROVER_SHARED_DIR=${ROVER_SHARED_DIR}")
   set(properties "LABELS \"${ARG_LABELS}\" ENVIRONMENT \"${environment}\"")
   if(ARG_RESOURCE_LOCK)
     string(APPEND properties " RESOURCE_LOCK \"${ARG_RESOURCE_LOCK}\"")
