@@ -68,13 +68,14 @@ int RunGenerate(const GenerateArgs& args) {
   std::printf(
       "dataset %s\n  scenario:    %s, seed %llu\n  simulated:   %.1f s, %.1f m driven\n"
       "  imu:         %llu samples\n  stereo:      %llu pairs (%s)\n  can:         %llu frames\n"
-      "  gpio:        %llu edges\n  wall time:   %.1f s (world %.1f s, render %.1f s, write "
+      "  gpio:        %llu edges\n  rovers:      %zu dataset(s)\n  wall time:   %.1f s (world %.1f "
+      "s, render %.1f s, write "
       "%.1f s), %.2fx real time\n",
       args.out_dir.c_str(), scenario.name.c_str(), static_cast<unsigned long long>(args.seed),
       r.sim_duration_s, r.distance_m, static_cast<unsigned long long>(r.imu_samples),
       static_cast<unsigned long long>(r.stereo_frames), r.gl_renderer.c_str(),
       static_cast<unsigned long long>(r.can_frames), static_cast<unsigned long long>(r.gpio_edges),
-      r.wall_time_s, r.world_time_s, r.render_time_s, r.write_time_s,
+      r.rover_datasets, r.wall_time_s, r.world_time_s, r.render_time_s, r.write_time_s,
       r.sim_duration_s / std::max(r.wall_time_s, 1e-9));
   return 0;
 }

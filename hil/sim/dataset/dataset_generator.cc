@@ -39,32 +39,29 @@ drivers::CameraCalibration CameraCalibrationOf(const StereoCameraOptions& cam,
 
 double SecondsSince(Time start) { return (Time::Now() - start).ToSeconds(); }
 
-}  // namespace
+// Everything one rover records, into its own EuRoC-layout folder.
+// `rovers[self]` is the recording rover; `carrier_rover[j]` is the rover that
+// moving tag carrier j belongs to (its own carrier is hidden from its view).
+struct RoverContext {
+  const Scenario& scenario;
+  const World& world;
+  const std::vector<const RoverTrajectory*>& rovers;
+  const std::vector<std::size_t>& carrier_rover;
+  std::size_t self;
+};
 
-GenerateResult GenerateDataset(const Scenario& scenario, const GenerateOptions& options) {
-  const Time wall_start = Time::Now();
-  GenerateResult result;
-  EurocWriter writer(options.out_dir);
-
-  const World world = World::Generate(scenario.world, options.seed);
-  ExportWorldGroundTruth(world, (std::filesystem::path(options.out_dir) / "world").string());
-  result.world_time_s = SecondsSince(wall_start);
-
-  const RoverTrajectory trajectory(scenario.route, world.terrain);
-  std::vector<RoverTrajectory> others;
-  others.reserve(scenario.other_rover_routes.size());
-  for (const Route& route : scenario.other_rover_routes) others.emplace_back(route, world.terrain);
-  const double duration_s = options.max_duration_s > 0
-                                ? std::min(options.max_duration_s, trajectory.duration_s())
-                                : trajectory.duration_s();
+void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
+                       const std::string& out_dir, double duration_s, GenerateResult* result) {
+  EurocWriter writer(out_dir);
+  const RoverTrajectory& trajectory = *c.rovers[c.self];
   const Time t0 = kDatasetStartTime;
   const Time end = t0 + Duration::FromSeconds(duration_s);
-  result.sim_duration_s = duration_s;
 
-  ImuModelOptions imu_options = scenario.imu;
-  imu_options.seed = scenario.imu.seed ^ (options.seed * 0x9E3779B97F4A7C15ULL);
+  ImuModelOptions imu_options = c.scenario.imu;
+  imu_options.seed = c.scenario.imu.seed ^ (options.seed * 0x9E3779B97F4A7C15ULL) ^
+                     (c.self * 0xC2B2AE3D27D4EB4FULL);
   writer.WriteImuCalibration(ImuCalibrationOf(imu_options));
-  const StereoCameraOptions& camera = scenario.camera;
+  const StereoCameraOptions& camera = c.scenario.camera;
   writer.WriteCameraCalibration(0, CameraCalibrationOf(camera, camera.T_body_cam0));
   writer.WriteCameraCalibration(1, CameraCalibrationOf(camera, camera.T_body_cam1()));
 
@@ -74,19 +71,18 @@ GenerateResult GenerateDataset(const Scenario& scenario, const GenerateOptions& 
   gpio_options.camera_rate_hz = camera.rate_hz;
   const GpioEdgeModel gpio(gpio_options, t0);
   ImuModel imu(imu_options, t0);
-  const Duration gt_period = Duration::FromSeconds(1.0 / scenario.ground_truth_rate_hz);
+  const Duration gt_period = Duration::FromSeconds(1.0 / c.scenario.ground_truth_rate_hz);
   Time next_gt = t0;
   double driven_m = 0;
   Eigen::Vector2d last_xy = trajectory.Evaluate(0).p_world_body.head<2>();
   for (;;) {
-    TrajectorySample truth;
-    const drivers::ImuSample sample = imu.Next(trajectory, &truth);
+    const drivers::ImuSample sample = imu.Next(trajectory);
     if (sample.stamp >= end) break;
     writer.AddImu(sample);
-    ++result.imu_samples;
+    ++result->imu_samples;
     for (const drivers::GpioEdge& edge : gpio.ImuDataReadyEdges(sample.stamp)) {
       writer.AddGpioEdge(edge, "imu_data_ready");
-      ++result.gpio_edges;
+      ++result->gpio_edges;
     }
     while (next_gt <= sample.stamp) {
       const TrajectorySample gt = trajectory.Evaluate((next_gt - t0).ToSeconds());
@@ -97,14 +93,14 @@ GenerateResult GenerateDataset(const Scenario& scenario, const GenerateOptions& 
       next_gt += gt_period;
     }
   }
-  result.distance_m = driven_m;
+  if (c.self == 0) result->distance_m = driven_m;
 
   // Wheel drives on the CAN bus.
   WheelOdometryOptions wheel_options;
-  if (!scenario.wheels_config.empty()) {
-    wheel_options = WheelOdometryOptions::LoadFile(scenario.wheels_config);
+  if (!c.scenario.wheels_config.empty()) {
+    wheel_options = WheelOdometryOptions::LoadFile(c.scenario.wheels_config);
   }
-  WheelOdometryModel wheels(wheel_options, trajectory, world.terrain, t0);
+  WheelOdometryModel wheels(wheel_options, trajectory, c.world.terrain, t0);
   std::vector<drivers::CanFrame> frames;
   std::vector<WheelSyncState> states;
   wheels.Advance(end, &frames, &states);
@@ -112,43 +108,103 @@ GenerateResult GenerateDataset(const Scenario& scenario, const GenerateOptions& 
   for (const WheelSyncState& s : states) {
     writer.AddWheel({s.stamp, s.angular_velocity_rad_s, s.encoder_ticks});
   }
-  result.can_frames = frames.size();
+  result->can_frames += frames.size();
 
   // Stereo pairs at the trigger edges.
   for (const drivers::GpioEdge& edge : gpio.CameraTriggerEdges(t0, end)) {
     writer.AddGpioEdge(edge, "camera_trigger");
-    ++result.gpio_edges;
+    ++result->gpio_edges;
   }
   const std::vector<Time> triggers = gpio.CameraTriggerTimes(t0, end);
-  StereoRenderer renderer(world, camera);
-  result.gl_renderer = renderer.gl_renderer();
+  StereoRenderer renderer(c.world, camera);
+  result->gl_renderer = renderer.gl_renderer();
   StereoFrame frame;
+  std::vector<const RoverTrajectory*> carriers;
+  std::size_t hidden = kNoHiddenCarrier;
+  for (std::size_t j = 0; j < c.carrier_rover.size(); ++j) {
+    carriers.push_back(c.rovers[c.carrier_rover[j]]);
+    if (c.carrier_rover[j] == c.self) hidden = j;
+  }
   std::vector<Eigen::Isometry3d> T_world_carriers;
   for (std::size_t k = 0; k < triggers.size(); ++k) {
     const double t_s = (triggers[k] - t0).ToSeconds();
-    MovingCarrierPoses(others, t_s, &T_world_carriers);
+    MovingCarrierPoses(carriers, hidden, t_s, &T_world_carriers);
     const Time render_start = Time::Now();
     renderer.Render(PoseOf(trajectory.Evaluate(t_s)), T_world_carriers, k, &frame);
     const Time write_start = Time::Now();
-    result.render_time_s += (write_start - render_start).ToSeconds();
+    result->render_time_s += (write_start - render_start).ToSeconds();
     writer.AddStereo(triggers[k], frame.cam0, frame.cam1);
     writer.AddDepth(triggers[k], frame.depth0_m);
     std::size_t moving = 0;
-    for (const TagCarrier& carrier : world.carriers) {
+    for (const TagCarrier& carrier : c.world.carriers) {
       if (carrier.is_static) continue;
-      for (const TagMarker& tag : carrier.tags) {
-        writer.AddTagPose(triggers[k], carrier.name, tag.id,
-                          T_world_carriers[moving] * tag.T_carrier_tag);
+      if (moving != hidden) {
+        for (const TagMarker& tag : carrier.tags) {
+          writer.AddTagPose(triggers[k], carrier.name, tag.id,
+                            T_world_carriers[moving] * tag.T_carrier_tag);
+        }
       }
       ++moving;
     }
-    result.write_time_s += SecondsSince(write_start);
-    ++result.stereo_frames;
+    result->write_time_s += SecondsSince(write_start);
+    ++result->stereo_frames;
     if (options.progress) {
-      options.progress(static_cast<double>(k + 1) / static_cast<double>(triggers.size()), t_s);
+      const double done = static_cast<double>(c.self) +
+                          static_cast<double>(k + 1) / static_cast<double>(triggers.size());
+      options.progress(done / static_cast<double>(c.rovers.size()), t_s);
     }
   }
   writer.Close();
+}
+
+}  // namespace
+
+GenerateResult GenerateDataset(const Scenario& scenario, const GenerateOptions& options) {
+  const Time wall_start = Time::Now();
+  GenerateResult result;
+  const std::filesystem::path out(options.out_dir);
+  if (std::filesystem::exists(out / "mav0")) {
+    throw drivers::DatasetError((out / "mav0").string() +
+                                ": already exists; choose an empty output folder");
+  }
+  const World world = World::Generate(scenario.world, options.seed);
+  ExportWorldGroundTruth(world, (out / "world").string());
+  result.world_time_s = SecondsSince(wall_start);
+
+  // Rover 0 records the main dataset; other rovers drive their own routes and
+  // record theirs into <out>/<carrier name>/.
+  std::vector<RoverTrajectory> trajectories;
+  trajectories.reserve(1 + scenario.other_rover_routes.size());
+  trajectories.emplace_back(scenario.route, world.terrain);
+  for (const Route& route : scenario.other_rover_routes) {
+    trajectories.emplace_back(route, world.terrain);
+  }
+  std::vector<const RoverTrajectory*> rovers;
+  for (const RoverTrajectory& t : trajectories) rovers.push_back(&t);
+  // World order of moving carriers: rover_b, rover_c, ..., then rover_a
+  // (the recording rover) when it carries tags too.
+  std::vector<std::size_t> carrier_rover;
+  std::vector<std::string> rover_names(rovers.size());
+  for (const TagCarrier& carrier : world.carriers) {
+    if (carrier.is_static) continue;
+    const std::size_t rover = carrier.name == "rover_a" ? 0 : carrier_rover.size() + 1;
+    if (rover >= rovers.size()) {
+      throw std::invalid_argument("world carrier " + carrier.name + " has no route");
+    }
+    carrier_rover.push_back(rover);
+    rover_names[rover] = carrier.name;
+  }
+
+  const double duration_s = options.max_duration_s > 0
+                                ? std::min(options.max_duration_s, rovers[0]->duration_s())
+                                : rovers[0]->duration_s();
+  result.sim_duration_s = duration_s;
+  for (std::size_t self = 0; self < rovers.size(); ++self) {
+    const RoverContext context{scenario, world, rovers, carrier_rover, self};
+    const std::string dir = self == 0 ? out.string() : (out / rover_names[self]).string();
+    GenerateRoverData(context, options, dir, duration_s, &result);
+  }
+  result.rover_datasets = rovers.size();
   result.wall_time_s = SecondsSince(wall_start);
   return result;
 }

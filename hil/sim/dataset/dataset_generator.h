@@ -35,9 +35,15 @@ struct GenerateResult {
   double render_time_s = 0.0;  ///< rendering the stereo pairs
   double write_time_s = 0.0;   ///< encoding and writing images
   std::string gl_renderer;
+  /// Datasets written: 1, plus one per other rover (in <out>/<rover name>/).
+  std::size_t rover_datasets = 0;
 };
 
 /// Generates the dataset into options.out_dir (which must not hold a mav0/).
+/// With other rovers in the scenario, every rover carries tags and each
+/// other rover's own recording goes to <out_dir>/<rover name>/ (rover_b, ...),
+/// so both sides of a mutual sighting are in the data. Counts in the result
+/// are summed over all rovers; distance is the main rover's.
 /// Throws on bad options or I/O errors, with a message naming what failed.
 GenerateResult GenerateDataset(const Scenario& scenario, const GenerateOptions& options);
 

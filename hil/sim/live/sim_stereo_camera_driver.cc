@@ -11,13 +11,14 @@ drivers::ImageView ViewOf(const cv::Mat& m) {
 
 SimStereoCameraDriver::SimStereoCameraDriver(StereoRenderer& renderer,
                                              const RoverTrajectory& trajectory,
-                                             const std::vector<RoverTrajectory>& others,
-                                             const GpioEdgeModel& triggers,
+                                             const std::vector<const RoverTrajectory*>& carriers,
+                                             std::size_t self, const GpioEdgeModel& triggers,
                                              const drivers::ReplayClock& clock, Time start,
                                              Time end)
     : renderer_(renderer),
       trajectory_(trajectory),
-      others_(others),
+      carriers_(carriers),
+      self_(self),
       triggers_(triggers),
       clock_(clock),
       start_(start),
@@ -28,7 +29,7 @@ drivers::ReadStatus SimStereoCameraDriver::Next(drivers::StereoFrame* frame, Dur
   if (trigger >= end_) return drivers::ReadStatus::kEndOfStream;
   if (!clock_.WaitUntilDue(trigger, timeout)) return drivers::ReadStatus::kTimeout;
   const double t_s = (trigger - start_).ToSeconds();
-  MovingCarrierPoses(others_, t_s, &T_world_carriers_);
+  MovingCarrierPoses(carriers_, self_, t_s, &T_world_carriers_);
   renderer_.Render(PoseOf(trajectory_.Evaluate(t_s)), T_world_carriers_, next_index_, &rendered_);
   frame->stamp = trigger;
   frame->sequence = next_index_++;

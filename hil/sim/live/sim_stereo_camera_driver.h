@@ -17,18 +17,21 @@ namespace rover::sim {
 
 class SimStereoCameraDriver final : public drivers::StereoCameraDriver {
  public:
-  /// Everything passed by reference must outlive the driver. `others` are
-  /// the trajectories of the world's moving tag carriers, in world order.
+  /// Everything passed by reference must outlive the driver. `carriers` are
+  /// the trajectories of the world's moving tag carriers, in world order;
+  /// carrier `self` (or kNoHiddenCarrier) is this rover's own.
   SimStereoCameraDriver(StereoRenderer& renderer, const RoverTrajectory& trajectory,
-                        const std::vector<RoverTrajectory>& others, const GpioEdgeModel& triggers,
-                        const drivers::ReplayClock& clock, Time start, Time end);
+                        const std::vector<const RoverTrajectory*>& carriers, std::size_t self,
+                        const GpioEdgeModel& triggers, const drivers::ReplayClock& clock,
+                        Time start, Time end);
   drivers::ReadStatus Next(drivers::StereoFrame* frame, Duration timeout) override;
   void Release(const drivers::StereoFrame& frame) override;
 
  private:
   StereoRenderer& renderer_;
   const RoverTrajectory& trajectory_;
-  const std::vector<RoverTrajectory>& others_;
+  const std::vector<const RoverTrajectory*>& carriers_;
+  std::size_t self_;
   const GpioEdgeModel& triggers_;
   const drivers::ReplayClock& clock_;
   Time start_;

@@ -530,12 +530,14 @@ std::array<double, kWheelCount> RoverTrajectory::WheelRollingSpeeds_m_s(
   return out;
 }
 
-void MovingCarrierPoses(const std::vector<RoverTrajectory>& trajectories, double t_s,
-                        std::vector<Eigen::Isometry3d>* T_world_carriers) {
+void MovingCarrierPoses(const std::vector<const RoverTrajectory*>& trajectories, std::size_t hidden,
+                        double t_s, std::vector<Eigen::Isometry3d>* T_world_carriers) {
   T_world_carriers->resize(trajectories.size());
   for (std::size_t i = 0; i < trajectories.size(); ++i) {
-    (*T_world_carriers)[i] = PoseOf(trajectories[i].Evaluate(t_s)) *
-                             Eigen::Translation3d(0, 0, -trajectories[i].options().body_height_m);
+    const RoverTrajectory& t = *trajectories[i];
+    (*T_world_carriers)[i] =
+        PoseOf(t.Evaluate(t_s)) * Eigen::Translation3d(0, 0, -t.options().body_height_m);
+    if (i == hidden) (*T_world_carriers)[i].translation().z() -= 1.0e4;
   }
 }
 

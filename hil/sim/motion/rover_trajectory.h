@@ -202,11 +202,16 @@ class RoverTrajectory : public MotionSource {
   QuinticBSpline z_m_, roll_rad_, pitch_rad_;
 };
 
+/// No carrier is hidden (see MovingCarrierPoses).
+inline constexpr std::size_t kNoHiddenCarrier = static_cast<std::size_t>(-1);
+
 /// World poses T_world_carrier of moving tag carriers at `t_s`, one per
 /// trajectory: a carrier's origin sits on its wheels' ground plane,
-/// body_height_m below its body (IMU) frame.
-void MovingCarrierPoses(const std::vector<RoverTrajectory>& trajectories, double t_s,
-                        std::vector<Eigen::Isometry3d>* T_world_carriers);
+/// body_height_m below its body (IMU) frame. Carrier `hidden` is the viewing
+/// rover itself: it is put far below the terrain so its camera never sees
+/// its own body from inside.
+void MovingCarrierPoses(const std::vector<const RoverTrajectory*>& trajectories, std::size_t hidden,
+                        double t_s, std::vector<Eigen::Isometry3d>* T_world_carriers);
 
 }  // namespace rover::sim
 

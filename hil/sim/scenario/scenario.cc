@@ -63,6 +63,8 @@ Scenario LoadScenario(const std::string& path, const std::string& config_dir) {
   };
   keep_clear(s.route);
   for (const Route& other : s.other_rover_routes) keep_clear(other);
+  // With other rovers around, every rover carries tags: sightings are mutual.
+  s.world.recording_rover_carries_tags = !s.other_rover_routes.empty();
   if (static_cast<int>(s.other_rover_routes.size()) != s.world.other_rover_count) {
     root.Fail("other_rovers", "has " + std::to_string(s.other_rover_routes.size()) +
                                   " routes but world.other_rover_count is " +

@@ -52,7 +52,9 @@ void Validate(const WorldOptions& o) {
           "counts must not be negative");
   require(o.tag_size_m > 0.0 && o.rover_tag_size_m > 0.0 && o.rover_tag_size_m <= 0.3,
           "tag sizes must be positive (rover tags at most 0.3 m, the body is 0.4 m high)");
-  require(4 * o.landmark_post_count + 5 * o.other_rover_count <= kTag36h11Ids,
+  require(4 * o.landmark_post_count +
+                  5 * (o.other_rover_count + (o.recording_rover_carries_tags ? 1 : 0)) <=
+              kTag36h11Ids,
           "more tags than the 587 ids of family 36h11");
   require(o.clear_radius_m >= 0.0, "clear_radius_m must not be negative");
 }
@@ -406,6 +408,10 @@ World World::Generate(const WorldOptions& options, uint64_t seed) {
   for (int k = 0; k < options.other_rover_count; ++k) {
     world.carriers.push_back(
         MakeOtherRover(OtherRoverName(k), next_tag_id, options.rover_tag_size_m));
+    next_tag_id += 5;
+  }
+  if (options.recording_rover_carries_tags) {
+    world.carriers.push_back(MakeOtherRover("rover_a", next_tag_id, options.rover_tag_size_m));
     next_tag_id += 5;
   }
 

@@ -183,7 +183,10 @@ struct WorldOptions {
   int rock_count = 400;         ///< fewer are placed if the area is too crowded
   int crater_count = 1;
   int landmark_post_count = 6;
-  int other_rover_count = 0;       ///< tag-carrying rovers (moving, posed at render time)
+  int other_rover_count = 0;  ///< tag-carrying rovers (moving, posed at render time)
+  /// The simulated rover itself ("rover_a") carries tags too, as the last
+  /// moving carrier, so other rovers can see it (mutual sightings).
+  bool recording_rover_carries_tags = false;
   double tag_size_m = 0.16;        ///< tags on landmark posts
   double rover_tag_size_m = 0.24;  ///< tags on other rovers
   double clear_radius_m = 3.0;     ///< around the origin (the rover start): no rocks, no posts

@@ -100,13 +100,13 @@ TEST(SimStereoCameraDriverTest, RendersAtTriggerTimes) {
   options.landmark_post_count = 1;
   const World world = World::Generate(options, 3);
   const RoverTrajectory trajectory(ShortRoute(), world.terrain);
-  const std::vector<RoverTrajectory> others;
+  const std::vector<const RoverTrajectory*> carriers;
   StereoCameraOptions camera;
   StereoRenderer renderer(world, camera);
   const GpioEdgeModel triggers(GpioEdgeOptions{}, kStart);
   const drivers::ReplayClock lockstep(false, kStart);
-  SimStereoCameraDriver driver(renderer, trajectory, others, triggers, lockstep, kStart,
-                               kStart + Duration::Milliseconds(250));
+  SimStereoCameraDriver driver(renderer, trajectory, carriers, kNoHiddenCarrier, triggers, lockstep,
+                               kStart, kStart + Duration::Milliseconds(250));
   drivers::StereoFrame frame;
   for (uint64_t k = 0; k < 3; ++k) {
     ASSERT_EQ(driver.Next(&frame, Duration::Zero()), drivers::ReadStatus::kOk);

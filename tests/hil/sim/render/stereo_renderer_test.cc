@@ -26,6 +26,7 @@
 
 #include "hil/sim/render/stereo_camera.h"
 #include "hil/sim/render/stereo_renderer.h"
+#include "tests/hil/sim/render/tag_detection.h"
 #include "tests/hil/sim/render/test_world.h"
 
 namespace rover::sim {
@@ -334,47 +335,9 @@ TEST(TerrainLodRenderTest, NoCracksBetweenPatchesOfDifferentLevels) {
 
 // ------------------------------------------------------------------ tags --
 
-// apriltag reports corners with pixel centres at integer + 0.5 (its own
-// convention), OpenCV at integers. Established on an ideal, pixel-aligned
-// image below, then used for the rendered tags.
-constexpr double kApriltagCentreOffsetPx = 0.5;
-
-struct Detection {
-  int id = 0;
-  std::array<Eigen::Vector2d, 4> corners_px;  // apriltag order, OpenCV convention
-};
-
-std::vector<Detection> DetectTags(const cv::Mat& image) {
-  apriltag_family_t* family = tag36h11_create();
-  apriltag_detector_t* detector = apriltag_detector_create();
-  apriltag_detector_add_family(detector, family);
-  detector->quad_decimate = 1.0f;
-  detector->quad_sigma = 0.0f;
-  detector->refine_edges = true;
-  detector->nthreads = 1;
-  // Debian's libapriltag does not export image_u8_create; the detector only
-  // reads the struct, so it can wrap the Mat's rows directly.
-  CV_Assert(image.type() == CV_8UC1);
-  image_u8_t im = {image.cols, image.rows, static_cast<int32_t>(image.step[0]),
-                   const_cast<uint8_t*>(image.ptr<uint8_t>(0))};
-  zarray_t* detections = apriltag_detector_detect(detector, &im);
-  std::vector<Detection> out;
-  for (int i = 0; i < zarray_size(detections); ++i) {
-    apriltag_detection_t* det = nullptr;
-    zarray_get(detections, i, &det);
-    Detection d;
-    d.id = det->id;
-    for (std::size_t c = 0; c < 4; ++c) {
-      d.corners_px[c] = Eigen::Vector2d(det->p[c][0] - kApriltagCentreOffsetPx,
-                                        det->p[c][1] - kApriltagCentreOffsetPx);
-    }
-    out.push_back(d);
-  }
-  apriltag_detections_destroy(detections);
-  apriltag_detector_destroy(detector);
-  tag36h11_destroy(family);
-  return out;
-}
+// DetectTags (tag_detection.h) shifts apriltag's corners (pixel centres at
+// integer + 0.5) to OpenCV's convention (integers). The shift is established
+// on an ideal, pixel-aligned image below, then used for the rendered tags.
 
 // Largest distance from each detected corner to the nearest of `expected`.
 double MaxCornerError(const Detection& detection, const std::vector<Eigen::Vector2d>& expected) {
