@@ -67,9 +67,7 @@ void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
 
   // IMU, its data-ready edges and the ground truth (with the IMU's true
   // biases) come from one pass over the IMU samples.
-  GpioEdgeOptions gpio_options;
-  gpio_options.camera_rate_hz = camera.rate_hz;
-  const GpioEdgeModel gpio(gpio_options, t0);
+  const GpioEdgeModel gpio(c.scenario.gpio, t0);
   ImuModel imu(imu_options, t0);
   const Duration gt_period = Duration::FromSeconds(1.0 / c.scenario.ground_truth_rate_hz);
   Time next_gt = t0;

@@ -79,6 +79,11 @@ Scenario LoadScenario(const std::string& path, const std::string& config_dir) {
   if (sensors.Has("wheels_config")) {
     s.wheels_config = (fs::path(config_dir) / sensors.Get<std::string>("wheels_config")).string();
   }
+  if (sensors.Has("gpio_config")) {
+    s.gpio = GpioEdgeOptions::LoadFile(
+        (fs::path(config_dir) / sensors.Get<std::string>("gpio_config")).string());
+  }
+  s.gpio.camera_rate_hz = s.camera.rate_hz;
   root.CheckNoUnknownKeysRecursive();
   return s;
 }

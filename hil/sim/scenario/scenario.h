@@ -11,6 +11,7 @@
 
 #include "hil/sim/motion/route.h"
 #include "hil/sim/render/stereo_camera.h"
+#include "hil/sim/sensors/gpio_edge_model.h"
 #include "hil/sim/sensors/imu_model.h"
 #include "hil/sim/world/world.h"
 
@@ -28,6 +29,9 @@ struct Scenario {
   double ground_truth_rate_hz = 100.0;
   /// Wheel odometry model file (hil/config), empty: defaults.
   std::string wheels_config;
+  /// GPIO edge model (trigger phase, lines, pulse widths); its camera rate is
+  /// replaced by camera.rate_hz so the rate has one source of truth.
+  GpioEdgeOptions gpio;
 };
 
 /// Loads a scenario file. Sensor config files it names are resolved relative
