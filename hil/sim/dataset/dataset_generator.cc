@@ -8,6 +8,7 @@
 #include "hil/sim/dataset/euroc_writer.h"
 #include "hil/sim/motion/rover_trajectory.h"
 #include "hil/sim/render/stereo_renderer.h"
+#include "hil/sim/seed.h"
 #include "hil/sim/sensors/gpio_edge_model.h"
 #include "hil/sim/sensors/imu_model.h"
 #include "hil/sim/sensors/wheel_odometry_model.h"

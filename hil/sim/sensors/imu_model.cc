@@ -4,19 +4,10 @@
 #include <cmath>
 #include <string>
 
+#include "hil/sim/seed.h"
+
 namespace rover::sim {
 namespace {
-
-// SplitMix64 finaliser: decorrelates the per-source seeds derived from one
-// user seed (consecutive user seeds must not give overlapping streams).
-uint64_t Mix(uint64_t x) {
-  x += 0x9E3779B97F4A7C15ULL;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
-}
-
-uint64_t StreamSeed(uint64_t seed, uint64_t stream) { return Mix(Mix(seed) ^ stream); }
 
 enum Stream : uint64_t { kGyroNoise = 1, kAccelNoise, kGyroWalk, kAccelWalk, kJitter, kTurnOn };
 

@@ -3,17 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hil/sim/seed.h"
 #include "hil/sim/sensors/canopen_wheel_protocol.h"
 
 namespace rover::sim {
 namespace {
-
-uint64_t Mix(uint64_t x) {
-  x += 0x9E3779B97F4A7C15ULL;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
-}
 
 constexpr auto kSyncPeriod = Duration::Milliseconds(10);  // 100 Hz, DESIGN.md
 
@@ -61,9 +55,9 @@ WheelOdometryModel::WheelOdometryModel(const WheelOdometryOptions& options,
       trajectory_(trajectory),
       terrain_(terrain),
       start_(start),
-      slip_rng_(Mix(Mix(options.seed) ^ 1)),
-      velocity_rng_(Mix(Mix(options.seed) ^ 2)),
-      timing_rng_(Mix(Mix(options.seed) ^ 3)) {
+      slip_rng_(StreamSeed(options.seed, 1)),
+      velocity_rng_(StreamSeed(options.seed, 2)),
+      timing_rng_(StreamSeed(options.seed, 3)) {
   // Start the slip noise in its stationary distribution.
   for (double& n : slip_noise_) n = options_.slip_noise_sigma * slip_normal_(slip_rng_);
   rates_ = RatesAt(0.0);
