@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 
 namespace rover::drivers {
 namespace {
@@ -75,13 +76,22 @@ class CsvFile {
     }
   }
 
-  /// Timestamps must increase strictly: replay merges streams by time.
-  Time Stamp(std::string_view cell, Time previous) const {
+  /// Reads three consecutive cells starting at `first` as a vector.
+  Eigen::Vector3d Vector3(const std::vector<std::string_view>& cells, std::size_t first,
+                          const char* column) const {
+    return {Double(cells[first], column), Double(cells[first + 1], column),
+            Double(cells[first + 2], column)};
+  }
+
+  /// The row's timestamp; timestamps must increase strictly down the file,
+  /// because replay merges streams by time.
+  Time Stamp(std::string_view cell) {
     const Time t = Time::FromNanoseconds(Int64(cell, "timestamp"));
-    if (t <= previous && previous != Time::FromNanoseconds(INT64_MIN)) {
+    if (previous_ && t <= *previous_) {
       Fail("timestamp " + std::to_string(t.nanoseconds()) + " does not increase (previous " +
-           std::to_string(previous.nanoseconds()) + ")");
+           std::to_string(previous_->nanoseconds()) + ")");
     }
+    previous_ = t;
     return t;
   }
 
@@ -90,24 +100,20 @@ class CsvFile {
   std::ifstream in_;
   std::string line_;
   int line_number_ = 0;
+  std::optional<Time> previous_;
 };
-
-constexpr Time kNoPrevious = Time::FromNanoseconds(INT64_MIN);
 
 std::vector<ImuSample> LoadImu(const std::string& path) {
   CsvFile csv(path);
   std::vector<ImuSample> samples;
   std::vector<std::string_view> c;
-  Time previous = kNoPrevious;
   while (csv.Next(&c)) {
     csv.ExpectColumns(c, 7);
     ImuSample s;
-    s.stamp = previous = csv.Stamp(c[0], previous);
+    s.stamp = csv.Stamp(c[0]);
     s.sequence = samples.size();
-    s.angular_velocity_rad_s = {csv.Double(c[1], "w_x"), csv.Double(c[2], "w_y"),
-                                csv.Double(c[3], "w_z")};
-    s.linear_acceleration_m_s2 = {csv.Double(c[4], "a_x"), csv.Double(c[5], "a_y"),
-                                  csv.Double(c[6], "a_z")};
+    s.angular_velocity_rad_s = csv.Vector3(c, 1, "w_RS_S");
+    s.linear_acceleration_m_s2 = csv.Vector3(c, 4, "a_RS_S");
     samples.push_back(s);
   }
   return samples;
@@ -119,11 +125,10 @@ std::map<int64_t, std::string> LoadCameraRows(const fs::path& cam_dir,
   CsvFile csv((cam_dir / "data.csv").string());
   std::map<int64_t, std::string> rows;
   std::vector<std::string_view> c;
-  Time previous = kNoPrevious;
   int missing = 0;
   while (csv.Next(&c)) {
     csv.ExpectColumns(c, 2);
-    const Time t = previous = csv.Stamp(c[0], previous);
+    const Time t = csv.Stamp(c[0]);
     const fs::path image = cam_dir / "data" / std::string(c[1]);
     if (!fs::exists(image)) {
       if (missing++ < 5) issues->push_back(image.string() + ": listed in data.csv but missing");
@@ -142,12 +147,11 @@ std::vector<GroundTruthState> LoadGroundTruth(const std::string& path) {
   CsvFile csv(path);
   std::vector<GroundTruthState> states;
   std::vector<std::string_view> c;
-  Time previous = kNoPrevious;
   while (csv.Next(&c)) {
     csv.ExpectColumns(c, 8);
     GroundTruthState s;
-    s.stamp = previous = csv.Stamp(c[0], previous);
-    s.p_world_body = {csv.Double(c[1], "p_x"), csv.Double(c[2], "p_y"), csv.Double(c[3], "p_z")};
+    s.stamp = csv.Stamp(c[0]);
+    s.p_world_body = csv.Vector3(c, 1, "p_RS_R");
     s.q_world_body = Eigen::Quaterniond(csv.Double(c[4], "q_w"), csv.Double(c[5], "q_x"),
                                         csv.Double(c[6], "q_y"), csv.Double(c[7], "q_z"));
     if (std::abs(s.q_world_body.norm() - 1.0) > 1e-3) {
@@ -156,12 +160,9 @@ std::vector<GroundTruthState> LoadGroundTruth(const std::string& path) {
     s.q_world_body.normalize();
     s.v_world_body_m_s = s.gyro_bias_rad_s = s.accel_bias_m_s2 = Eigen::Vector3d::Zero();
     if (c.size() >= 17) {
-      s.v_world_body_m_s = {csv.Double(c[8], "v_x"), csv.Double(c[9], "v_y"),
-                            csv.Double(c[10], "v_z")};
-      s.gyro_bias_rad_s = {csv.Double(c[11], "bw_x"), csv.Double(c[12], "bw_y"),
-                           csv.Double(c[13], "bw_z")};
-      s.accel_bias_m_s2 = {csv.Double(c[14], "ba_x"), csv.Double(c[15], "ba_y"),
-                           csv.Double(c[16], "ba_z")};
+      s.v_world_body_m_s = csv.Vector3(c, 8, "v_RS_R");
+      s.gyro_bias_rad_s = csv.Vector3(c, 11, "b_w_RS_S");
+      s.accel_bias_m_s2 = csv.Vector3(c, 14, "b_a_RS_S");
     }
     states.push_back(s);
   }

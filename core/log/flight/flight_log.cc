@@ -95,21 +95,24 @@ void FlightLog::DrainAll() {
       }
     }
   } catch (const std::exception& e) {
-    // The file is unusable past this point (disk full, I/O error). Keep the
-    // first error; producers keep running and their losses keep being counted.
-    std::lock_guard lock(stats_mutex_);
-    if (error_.empty()) error_ = e.what();
+    // The file is unusable past this point (disk full, I/O error); producers
+    // keep running and their losses keep being counted.
+    RecordError(e);
   }
   std::lock_guard lock(stats_mutex_);
   mcap_stats_ = writer_.stats();
+}
+
+void FlightLog::RecordError(const std::exception& e) {
+  std::lock_guard lock(stats_mutex_);
+  if (error_.empty()) error_ = e.what();  // the first error explains the rest
 }
 
 void FlightLog::FlushChunk() {
   try {
     writer_.FlushChunk();
   } catch (const std::exception& e) {
-    std::lock_guard lock(stats_mutex_);
-    if (error_.empty()) error_ = e.what();
+    RecordError(e);
   }
 }
 
@@ -133,8 +136,7 @@ void FlightLog::WriteHealth(Time now) {
     const auto t = static_cast<uint64_t>(now.nanoseconds());
     writer_.WriteMessage(health_channel_id_, health_sequence_++, t, t, health_buffer_);
   } catch (const std::exception& e) {
-    std::lock_guard lock(stats_mutex_);
-    if (error_.empty()) error_ = e.what();
+    RecordError(e);
   }
 }
 
@@ -155,8 +157,7 @@ void FlightLog::Stop() {
     try {
       writer_.Close();
     } catch (const std::exception& e) {
-      std::lock_guard lock(stats_mutex_);
-      if (error_.empty()) error_ = e.what();
+      RecordError(e);
     }
   }
   std::lock_guard lock(stats_mutex_);

@@ -13,6 +13,7 @@
 // left, writes a final LogHealth and closes the file with its summary.
 
 #include <condition_variable>
+#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -86,6 +87,7 @@ class FlightLog {
   void Run();
   void DrainAll();
   void FlushChunk();
+  void RecordError(const std::exception& e);
   void WriteHealth(Time now);
 
   FlightLogOptions options_;
