@@ -13,3 +13,6 @@ echo
 echo "== Flight log"
 "$build/bench/log/bench_log" --dir "$scratch"
 rm -rf "$scratch"
+echo
+echo "== Local reference filter"
+"$build/bench/estimator/bench_eskf"
