@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "estimator/eskf/update/chi_square_gate.h"
 
 namespace rover::estimator {
 
@@ -10,7 +9,7 @@ ZeroVelocityUpdater::ZeroVelocityUpdater(const ZuptOptions& options, const ImuNo
     : options_(options),
       gyro_sample_sigma_rad_s_(imu.gyro_noise_density_rad_s_sqrt_hz * imu.noise_inflation *
                                std::sqrt(imu.rate_hz)),
-      gate_(ChiSquareGate(6, 0.9999)) {}
+      gate_(0.0) {}
 
 LinearisedMeasurement<6, 2> ZeroVelocityUpdater::Linearise(const FilterState& state,
                                                            const Eigen::Vector3d& mean_gyro,

@@ -3,7 +3,9 @@
 
 // Standstill measurements: zero velocity (h = v, z = 0) and zero angular
 // rate (h = b_g, z = mean gyro reading over the detection window, whose noise
-// is the white gyro noise averaged over the window).
+// is the white gyro noise averaged over the window). Not gated: the
+// standstill detector (wheels and IMU both still) is the test, and a gate
+// would lock out exactly the update that repairs an overconfident velocity.
 
 #include "estimator/eskf/eskf_options.h"
 #include "estimator/eskf/state/filter_state.h"
@@ -20,14 +22,14 @@ class ZeroVelocityUpdater {
                                         const Eigen::Vector3d& mean_gyro_rad_s,
                                         int window_samples) const;
 
-  /// Gates (6 dof) and applies the update.
+  /// Applies the update (never gated).
   UpdateOutcome Update(FilterState& state, const Eigen::Vector3d& mean_gyro_rad_s,
                        int window_samples) const;
 
  private:
   ZuptOptions options_;
   double gyro_sample_sigma_rad_s_;
-  double gate_;
+  double gate_;  ///< 0: no gate
 };
 
 }  // namespace rover::estimator
