@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-
 namespace rover::estimator {
 
 ZeroVelocityUpdater::ZeroVelocityUpdater(const ZuptOptions& options, const ImuNoiseOptions& imu)
