@@ -70,6 +70,11 @@ WheelOdometryOptions WheelOdometryOptions::Load(const ConfigNode& n) {
   o.track_m = n.GetInRange<double>("track_m", 0.05, 5.0, o.track_m);
   o.yaw_scrub_factor = n.GetInRange<double>("yaw_scrub_factor", 0.5, 5.0, o.yaw_scrub_factor);
   o.lever_arm_body_m = n.Get<Eigen::Vector3d>("lever_arm_body_m", o.lever_arm_body_m);
+  o.nonholonomic_point_body_m =
+      n.Get<Eigen::Vector3d>("nonholonomic_point_body_m", o.nonholonomic_point_body_m);
+  o.slip_ratio_base = n.GetInRange<double>("slip_ratio_base", 0.0, 0.9, o.slip_ratio_base);
+  o.slip_ratio_per_tilt_rad =
+      n.GetInRange<double>("slip_ratio_per_tilt_rad", 0.0, 10.0, o.slip_ratio_per_tilt_rad);
   o.update_period_s = n.GetInRange<double>("update_period_s", 0.0, 1.0, o.update_period_s);
   o.forward_sigma_m_s = n.GetInRange<double>("forward_sigma_m_s", 1e-5, 10.0, o.forward_sigma_m_s);
   o.forward_sigma_per_speed =

@@ -68,9 +68,17 @@ struct WheelOdometryOptions {
   double wheel_radius_m = 0.1;
   double track_m = 0.5;           ///< left to right wheel centre
   double yaw_scrub_factor = 1.3;  ///< skid steer: wheel-speed difference / ideal
-  /// Position of the wheel-axle centre (the point whose velocity the wheels
-  /// measure) in the body frame.
+  /// Position of the wheel-axle centre (the point whose forward velocity the
+  /// wheels measure) in the body frame.
   Eigen::Vector3d lever_arm_body_m{0.0, 0.0, -0.25};
+  /// The point with no sideways velocity for the non-holonomic constraint,
+  /// in the body frame: the centre of the wheel contacts on a real rover.
+  Eigen::Vector3d nonholonomic_point_body_m{0.0, 0.0, -0.35};
+  /// Expected longitudinal slip s = base + per_tilt * tilt (tilt: angle of
+  /// the body z axis from vertical), from a wheel-terrain calibration; the
+  /// wheel speed is scaled by (1 - s) before the update. 0: no compensation.
+  double slip_ratio_base = 0.0;
+  double slip_ratio_per_tilt_rad = 0.0;
   double update_period_s = 0.1;           ///< wheel readings are averaged over this period
   double forward_sigma_m_s = 0.01;        ///< at zero speed
   double forward_sigma_per_speed = 0.03;  ///< grows with |speed| (unmodelled slip ratio)

@@ -236,16 +236,29 @@ void LocalReferenceFilter::CloneLate(Time stamp) {
 bool LocalReferenceFilter::MakeRoomForClone() {
   FilterState& s = *state_;
   if (s.clone_count < options_.clones.max_clones) return true;
-  // Prefer the oldest clone that is neither a keyframe nor awaiting its
-  // measurement (should not exist, but is free), then the oldest keyframe,
-  // then the oldest clone at all.
+  // Victim, in order of preference:
+  //  1. the oldest measured non-keyframe clone (normally already gone);
+  //  2. the oldest keyframe other than the newest one: the VO measures from
+  //     its newest keyframe most of the time, and older keyframes only
+  //     matter for revisits;
+  //  3. the oldest clone still waiting for its measurement: with 0.1 s
+  //     frames and up to 0.5 s latency, the oldest pending one is the most
+  //     likely to be a frame the VO dropped;
+  //  4. the oldest clone.
+  int newest_keyframe = -1;
+  for (int i = 0; i < s.clone_count; ++i) {
+    if (s.clones[static_cast<size_t>(i)].keyframe) newest_keyframe = i;
+  }
   int victim = -1;
   for (int i = 0; i < s.clone_count && victim < 0; ++i) {
     const PoseClone& c = s.clones[static_cast<size_t>(i)];
     if (c.measured && !c.keyframe) victim = i;
   }
   for (int i = 0; i < s.clone_count && victim < 0; ++i) {
-    if (s.clones[static_cast<size_t>(i)].keyframe) victim = i;
+    if (s.clones[static_cast<size_t>(i)].keyframe && i != newest_keyframe) victim = i;
+  }
+  for (int i = 0; i < s.clone_count && victim < 0; ++i) {
+    if (!s.clones[static_cast<size_t>(i)].keyframe) victim = i;
   }
   if (victim < 0) victim = 0;
   s.RemoveClone(victim);
@@ -335,7 +348,9 @@ void LocalReferenceFilter::AddWheelSpeeds(const WheelSpeedMeasurement& m) {
   }
   if (m.stamp <= last_wheel_stamp_) return Reject(m.stamp, kind, RejectReason::kOutOfOrder);
   last_wheel_stamp_ = m.stamp;
-  last_wheel_rates_ = m.wheel_rate_rad_s;
+  for (double w : m.wheel_rate_rad_s) {
+    if (std::abs(w) >= options_.zupt.wheel_rate_threshold_rad_s) last_wheel_motion_ = m.stamp;
+  }
   if (!initialised_) return Reject(m.stamp, kind, RejectReason::kNotInitialised);
   if (state_->core.stamp - m.stamp > SecondsToDuration(options_.wheels.max_delay_s)) {
     return Reject(m.stamp, kind, RejectReason::kTooOld);
@@ -377,13 +392,11 @@ void LocalReferenceFilter::MaybeZeroVelocityUpdate() {
   FilterState& s = *state_;
   const bool wheels_recent = s.core.stamp - last_wheel_stamp_ <=
                              SecondsToDuration(4.0 * options_.wheels.update_period_s + 0.05);
-  bool wheels_still = false;
-  if (wheels_recent) {
-    wheels_still = true;
-    for (double w : last_wheel_rates_) wheels_still &= std::abs(w) < z.wheel_rate_threshold_rad_s;
-  } else if (!z.allow_imu_only) {
-    return;
-  }
+  // The wheels must have been still for the whole IMU window: at the end of
+  // a turn the wheels stop while the window still holds the slowing
+  // rotation, which would otherwise leak into the gyro bias.
+  const bool wheels_still = s.core.stamp - last_wheel_motion_ > SecondsToDuration(z.window_s);
+  if (!wheels_recent && !z.allow_imu_only) return;
   if (wheels_recent && !wheels_still) return;
   const Eigen::Vector3d rate = zupt_detector_.MeanGyro() - s.core.gyro_bias_rad_s;
   if (rate.norm() > z.gyro_threshold_rad_s ||

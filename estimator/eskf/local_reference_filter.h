@@ -100,7 +100,7 @@ class LocalReferenceFilter {
   int wheel_count_ = 0;
   Time wheel_window_start_;
   Time last_wheel_stamp_ = kNever;
-  std::array<double, 4> last_wheel_rates_{};
+  Time last_wheel_motion_ = kNever;  ///< latest reading with a turning wheel
 
   // Health bookkeeping.
   static constexpr Time kNever = Time::FromNanoseconds(std::numeric_limits<int64_t>::min() / 2);

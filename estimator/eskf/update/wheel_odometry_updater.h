@@ -1,15 +1,19 @@
 #ifndef ROVER_ESTIMATOR_ESKF_UPDATE_WHEEL_ODOMETRY_UPDATER_H_
 #define ROVER_ESTIMATOR_ESKF_UPDATE_WHEEL_ODOMETRY_UPDATER_H_
 
-// Wheel odometry of a four-wheel skid-steered rover as a body-velocity
-// measurement at the wheel-axle centre c (lever arm l from the IMU):
-//   h(x) = R^T v + (w_m - b_g) x l,   rows: forward (x), lateral (y).
-//   forward  z = r (w_FL + w_FR + w_RL + w_RR) / 4
-//   lateral  z = 0 (non-holonomic constraint, optional)
-//   yaw rate z = r (w_R - w_L) / (track * scrub)  vs  e_z^T (w_m - b_g) (optional)
-// Linearised: d(R^T v) = R^T dv + [R^T v]x dtheta, d(w x l) = [l]x dbg.
-// The forward noise grows with speed (unmodelled slip ratio) and with the
-// estimated slip, the disagreement between front and rear wheels of a side.
+// Wheel odometry of a four-wheel skid-steered rover as body-velocity
+// measurements of two points: the wheel-axle centre c (lever arm l_c from the
+// IMU), whose forward speed the wheels measure, and the contact centre n
+// (lever arm l_n), which has no sideways velocity:
+//   forward  z = (1 - s) r (w_FL + w_FR + w_RL + w_RR) / 4,  h = e_x^T (R^T v + w x l_c)
+//   lateral  z = 0 (non-holonomic, optional),             h = e_y^T (R^T v + w x l_n)
+//   yaw rate z = r (w_R - w_L) / (track * scrub) (optional), h = e_z^T w
+// with w = w_m - b_g and s = s0 + k tilt the expected slip from a
+// wheel-terrain calibration (tilt from the current attitude; treated as
+// known, not differentiated). Linearised: d(R^T v) = R^T dv + [R^T v]x dtheta,
+// d(w x l) = [l]x dbg. The forward noise grows with speed (slip left after
+// compensation) and with the estimated slip, the disagreement between the
+// front and rear wheels of a side.
 
 #include <array>
 
@@ -31,8 +35,11 @@ class WheelOdometryUpdater {
  public:
   explicit WheelOdometryUpdater(const WheelOdometryOptions& options);
 
-  /// Body velocities from (averaged) wheel rates.
+  /// Body velocities from (averaged) wheel rates, before slip compensation.
   WheelVelocity FromWheelRates(const std::array<double, 4>& wheel_rate_rad_s) const;
+
+  /// The expected slip ratio at attitude R_local_body.
+  double ExpectedSlip(const Eigen::Matrix3d& R_local_body) const;
 
   /// Rows: forward, lateral, yaw rate; unused rows have zero Jacobian and
   /// residual (they do not change the update) and unit noise.

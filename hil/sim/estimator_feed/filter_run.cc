@@ -177,6 +177,14 @@ estimator::EskfOptions EskfOptionsForFeed(const FilterFeed& feed) {
   Eigen::Vector3d axle = Eigen::Vector3d::Zero();
   for (int w = 0; w < kWheelCount; ++w) axle += feed.trajectory().WheelCenterBody(w);
   o.wheels.lever_arm_body_m = axle / kWheelCount;
+  // The simulated rover's planar path is that of the body origin (the IMU):
+  // it is the point without sideways velocity (a real rover's is the wheel
+  // contact centre, the filter's default).
+  o.wheels.nonholonomic_point_body_m = Eigen::Vector3d::Zero();
+  // The wheel-terrain slip calibration: the simulator's mean slip against
+  // tilt (its roughness term and slip noise stay unmodelled).
+  o.wheels.slip_ratio_base = feed.wheel_options().slip_base_ratio;
+  o.wheels.slip_ratio_per_tilt_rad = feed.wheel_options().slip_slope_gain_per_rad;
   return o;
 }
 
