@@ -16,3 +16,6 @@ rm -rf "$scratch"
 echo
 echo "== Local reference filter"
 "$build/bench/estimator/bench_eskf"
+echo
+echo "== Pose graph (bench_graph; add --outliers for the false-loop-closure study)"
+"$build/bench/graph/bench_graph"

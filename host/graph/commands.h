@@ -1,0 +1,36 @@
+#ifndef ROVER_HOST_GRAPH_COMMANDS_H_
+#define ROVER_HOST_GRAPH_COMMANDS_H_
+
+// The subcommands of `rover-graph`, as functions writing to streams so tests
+// can call them directly. Each returns the process exit status: 0 success,
+// 1 invalid input (the message names the file and line or the problem),
+// 2 an output file could not be written.
+
+#include <ostream>
+#include <string>
+
+#include "mapping/graph/pose_graph_solver.h"
+
+namespace rover::host {
+
+struct SolveCommandOptions {
+  std::string input;
+  std::string output;
+  mapping::PoseGraphSolverOptions solver;
+  /// Print one line per Ceres iteration.
+  bool progress = true;
+};
+
+/// `rover-graph solve IN.g2o OUT.g2o`: initialise, optimise, write OUT, print
+/// iterations, times, final cost, chi2 and the SE-Sync objective F, ending
+/// with one machine-readable line
+///   RESULT dataset=... objective=... iterations=... time_s=... final_cost=... F=... chi2=...
+int RunSolve(const SolveCommandOptions& options, std::ostream& out, std::ostream& err);
+
+/// `rover-graph info IN.g2o`: dimension, vertex and edge counts, loop
+/// closures, connected components, F and chi2 of the file's initial guess.
+int RunInfo(const std::string& path, std::ostream& out, std::ostream& err);
+
+}  // namespace rover::host
+
+#endif  // ROVER_HOST_GRAPH_COMMANDS_H_

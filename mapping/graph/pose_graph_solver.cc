@@ -1,0 +1,344 @@
+#include "mapping/graph/pose_graph_solver.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+#include "mapping/graph/chordal_initialisation.h"
+#include "mapping/graph/chordal_pose_2d_cost.h"
+#include "mapping/graph/chordal_pose_3d_cost.h"
+#include "mapping/graph/graph_connectivity.h"
+#include "mapping/graph/pose_manifold.h"
+#include "mapping/graph/relative_pose_2d_cost.h"
+#include "mapping/graph/relative_pose_3d_cost.h"
+#include "mapping/graph/se_sync_objective.h"
+
+namespace rover::mapping {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// rho(s) = w * s with a weight that GNC changes between solves.
+class WeightLoss final : public ceres::LossFunction {
+ public:
+  void Evaluate(double s, double rho[3]) const override {
+    rho[0] = weight * s;
+    rho[1] = weight;
+    rho[2] = 0.0;
+  }
+  double weight = 1.0;
+};
+
+class ProgressCallback final : public ceres::IterationCallback {
+ public:
+  ProgressCallback(const std::function<void(int, double, double)>& f, Clock::time_point start)
+      : f_(f), start_(start) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    f_(s.iteration, s.cost, Seconds(start_));
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::function<void(int, double, double)>& f_;
+  Clock::time_point start_;
+};
+
+// The Ceres problem of one g2o graph: one parameter block per vertex.
+class Problem {
+ public:
+  Problem(PoseGraph& graph, const PoseGraphSolverOptions& options)
+      : graph_(graph), options_(options), planar_(graph.dimension == 2) {
+    ceres::Problem::Options po;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.enable_fast_removal = false;
+    problem_ = std::make_unique<ceres::Problem>(po);
+    const size_t n = graph.vertices.size();
+    stride_ = planar_ ? 3 : 7;
+    params_.resize(n * stride_);
+    ToParameters();
+    for (size_t k = 0; k < n; ++k) {
+      if (planar_) {
+        problem_->AddParameterBlock(Block(k), 3);
+      } else {
+        problem_->AddParameterBlock(Block(k), 7, &manifold_);
+      }
+    }
+    problem_->SetParameterBlockConstant(Block(0));
+    const auto index = VertexIndex(graph);
+    cauchy_ = std::make_unique<ceres::CauchyLoss>(options.cauchy_scale);
+    weights_.resize(graph.edges.size());
+    for (size_t k = 0; k < graph.edges.size(); ++k) {
+      const PoseEdge& e = graph.edges[k];
+      double* bi = Block(static_cast<size_t>(index.at(e.from)));
+      double* bj = Block(static_cast<size_t>(index.at(e.to)));
+      ceres::LossFunction* loss = nullptr;
+      if (IsLoopClosure(e)) {
+        if (options.outliers == OutlierHandling::kCauchy) loss = cauchy_.get();
+        if (options.outliers == OutlierHandling::kGnc) loss = &weights_[k];
+      }
+      residual_ids_.push_back(problem_->AddResidualBlock(MakeCost(e), loss, bi, bj));
+    }
+  }
+
+  ceres::CostFunction* MakeCost(const PoseEdge& e) const {
+    if (options_.objective == Objective::kSeSync) {
+      const IsotropicWeights w = SeSyncWeights(e, graph_.dimension);
+      if (planar_) return new ChordalPose2dCost(PlanarPose(e.measurement), w.kappa, w.tau);
+      return new ChordalPose3dCost(e.measurement, w.kappa, w.tau);
+    }
+    if (planar_) {
+      return new RelativePose2dCost(PlanarPose(e.measurement), PlanarInformation(e.information));
+    }
+    return new RelativePose3dCost(e.measurement, e.information);
+  }
+
+  double* Block(size_t k) { return params_.data() + k * stride_; }
+
+  void ToParameters() {
+    for (size_t k = 0; k < graph_.vertices.size(); ++k) {
+      const Eigen::Isometry3d& T = graph_.vertices[k].pose;
+      if (planar_) {
+        const Eigen::Vector3d p = PlanarPose(T);
+        std::copy(p.data(), p.data() + 3, Block(k));
+      } else {
+        PoseToParameters(T, Block(k));
+      }
+    }
+  }
+
+  void FromParameters() {
+    for (size_t k = 0; k < graph_.vertices.size(); ++k) {
+      const double* b = Block(k);
+      graph_.vertices[k].pose =
+          planar_ ? PoseFromPlanar(b[0], b[1], WrapAngle(b[2])) : PoseFromParameters(b);
+    }
+  }
+
+  // Squared residual norm of every edge (without loss).
+  std::vector<double> SquaredResiduals() {
+    std::vector<double> out(residual_ids_.size());
+    const int size = planar_ ? (options_.objective == Objective::kSeSync ? 4 : 3)
+                             : (options_.objective == Objective::kSeSync ? 12 : 6);
+    std::vector<double> r(static_cast<size_t>(size));
+    for (size_t k = 0; k < residual_ids_.size(); ++k) {
+      double cost = 0.0;
+      problem_->EvaluateResidualBlock(residual_ids_[k], false, &cost, r.data(), nullptr);
+      double s = 0.0;
+      for (const double v : r) s += v * v;
+      out[k] = s;
+    }
+    return out;
+  }
+
+  ceres::Solver::Summary Solve(int max_iterations, Clock::time_point start) {
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    so.sparse_linear_algebra_library_type =
+        ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ? ceres::SUITE_SPARSE
+                                                                              : ceres::EIGEN_SPARSE;
+    so.trust_region_strategy_type = options_.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+    so.initial_trust_region_radius = options_.initial_trust_region_radius;
+
+    so.max_num_iterations = max_iterations;
+    so.num_threads = options_.num_threads;
+    so.function_tolerance = options_.function_tolerance;
+    so.gradient_tolerance = options_.gradient_tolerance;
+    so.parameter_tolerance = options_.parameter_tolerance;
+    so.minimizer_progress_to_stdout = false;
+    so.logging_type = ceres::SILENT;
+    ProgressCallback callback(options_.progress, start);
+    if (options_.progress) so.callbacks.push_back(&callback);
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, problem_.get(), &summary);
+    return summary;
+  }
+
+  std::vector<WeightLoss>& weights() { return weights_; }
+
+ private:
+  PoseGraph& graph_;
+  const PoseGraphSolverOptions& options_;
+  bool planar_;
+  size_t stride_ = 7;
+  std::vector<double> params_;
+  PoseManifold manifold_;
+  std::unique_ptr<ceres::CauchyLoss> cauchy_;
+  std::vector<WeightLoss> weights_;
+  std::vector<ceres::ResidualBlockId> residual_ids_;
+  std::unique_ptr<ceres::Problem> problem_;  // Destroyed first: it points at the above.
+};
+
+}  // namespace
+
+bool IsLoopClosure(const PoseEdge& edge) { return std::llabs(edge.to - edge.from) != 1; }
+
+PoseGraphSolverOptions PoseGraphSolverOptions::Load(const ConfigNode& node) {
+  PoseGraphSolverOptions o;
+  o.objective = node.GetEnum<Objective>(
+      "objective", {{"chi2", Objective::kChi2}, {"sesync", Objective::kSeSync}}, o.objective);
+  o.initialisation = node.GetEnum<Initialisation>("initialisation",
+                                                  {{"chordal", Initialisation::kChordal},
+                                                   {"odometry", Initialisation::kOdometry},
+                                                   {"file", Initialisation::kFile}},
+                                                  o.initialisation);
+  o.outliers = node.GetEnum<OutlierHandling>("outliers",
+                                             {{"none", OutlierHandling::kNone},
+                                              {"cauchy", OutlierHandling::kCauchy},
+                                              {"gnc", OutlierHandling::kGnc}},
+                                             o.outliers);
+  o.cauchy_scale = node.GetInRange<double>("cauchy_scale", 1e-6, 1e6, o.cauchy_scale);
+  o.gnc_threshold = node.GetInRange<double>("gnc_threshold", 1e-6, 1e9, o.gnc_threshold);
+  o.gnc_step = node.GetInRange<double>("gnc_step", 1.01, 10.0, o.gnc_step);
+  o.dogleg = node.GetEnum<bool>("trust_region", {{"lm", false}, {"dogleg", true}}, o.dogleg);
+  o.initial_trust_region_radius = node.GetInRange<double>("initial_trust_region_radius", 1e-6, 1e16,
+                                                          o.initial_trust_region_radius);
+  o.max_iterations = node.GetInRange<int>("max_iterations", 1, 100000, o.max_iterations);
+  o.num_threads = node.GetInRange<int>("num_threads", 1, 256, o.num_threads);
+  o.function_tolerance =
+      node.GetInRange<double>("function_tolerance", 0.0, 1.0, o.function_tolerance);
+  o.gradient_tolerance =
+      node.GetInRange<double>("gradient_tolerance", 0.0, 1.0, o.gradient_tolerance);
+  o.parameter_tolerance =
+      node.GetInRange<double>("parameter_tolerance", 0.0, 1.0, o.parameter_tolerance);
+  return o;
+}
+
+std::vector<bool> RobustChordalInitialisation(PoseGraph& graph,
+                                              const PoseGraphSolverOptions& options) {
+  // Graduated non-convexity with the Geman-McClure surrogate (Yang et al.
+  // 2020) around the chordal relaxation: each step is one weighted linear
+  // chordal solve; loop-closure weights w = (mu c^2 / (r^2 + mu c^2))^2 with
+  // r^2 the edge's F term; mu shrinks from "almost least squares" to 1.
+  CheckGaugeAndFinite(graph);
+  const double c2 = options.gnc_threshold;
+  std::vector<double> weights(graph.edges.size(), 1.0);
+  const auto index = VertexIndex(graph);
+  auto residuals = [&] {
+    std::vector<double> r2(graph.edges.size(), 0.0);
+    for (size_t k = 0; k < graph.edges.size(); ++k) {
+      const PoseEdge& e = graph.edges[k];
+      r2[k] = SeSyncEdgeTerm(e, graph.dimension,
+                             graph.vertices[static_cast<size_t>(index.at(e.from))].pose,
+                             graph.vertices[static_cast<size_t>(index.at(e.to))].pose);
+    }
+    return r2;
+  };
+  ChordalInitialisation(graph, &weights);
+  std::vector<double> r2 = residuals();
+  double max_r2 = 0.0;
+  for (size_t k = 0; k < r2.size(); ++k) {
+    if (IsLoopClosure(graph.edges[k])) max_r2 = std::max(max_r2, r2[k]);
+  }
+  double mu = std::max(1.0, 2.0 * max_r2 / c2);
+  while (true) {
+    for (size_t k = 0; k < r2.size(); ++k) {
+      if (!IsLoopClosure(graph.edges[k])) continue;
+      const double a = mu * c2 / (r2[k] + mu * c2);
+      weights[k] = a * a;
+    }
+    ChordalInitialisation(graph, &weights);
+    r2 = residuals();
+    if (mu <= 1.0) break;
+    mu = std::max(1.0, mu / options.gnc_step);
+  }
+  std::vector<bool> inlier(graph.edges.size(), true);
+  for (size_t k = 0; k < r2.size(); ++k) {
+    if (IsLoopClosure(graph.edges[k])) inlier[k] = weights[k] > 0.5;
+  }
+  for (size_t k = 0; k < r2.size(); ++k) weights[k] = inlier[k] ? 1.0 : 0.0;
+  ChordalInitialisation(graph, &weights);
+  return inlier;
+}
+
+PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options) {
+  CheckGaugeAndFinite(graph);
+  PoseGraphSolverSummary out;
+  const Clock::time_point start = Clock::now();
+  const bool file_has_guess = !graph.vertices_implied;
+  out.inlier.assign(graph.edges.size(), true);
+  if (options.outliers == OutlierHandling::kGnc) {
+    out.inlier = RobustChordalInitialisation(graph, options);
+  } else
+    switch (options.initialisation) {
+      case Initialisation::kChordal:
+        ChordalInitialisation(graph);
+        break;
+      case Initialisation::kOdometry:
+        OdometryInitialisation(graph);
+        break;
+      case Initialisation::kFile:
+        if (!file_has_guess) OdometryInitialisation(graph);
+        break;
+    }
+  out.init_time_s = Seconds(start);
+  const Clock::time_point solve_start = Clock::now();
+  for (const PoseEdge& e : graph.edges) out.loop_closures += IsLoopClosure(e) ? 1 : 0;
+
+  Problem problem(graph, options);
+  bool first = true;
+  auto run = [&](int max_iterations) {
+    const ceres::Solver::Summary s = problem.Solve(max_iterations, start);
+    if (first) out.initial_cost = s.initial_cost;
+    first = false;
+    out.iterations += static_cast<int>(s.iterations.size()) - 1;
+    out.final_cost = s.final_cost;
+    out.converged = s.termination_type == ceres::CONVERGENCE;
+    out.message = s.BriefReport();
+  };
+
+  if (options.outliers == OutlierHandling::kGnc) {
+    // The GNC weights came from the robust chordal initialisation; refine on
+    // the kept edges, re-classify every loop closure at the refined solution
+    // (re-admitting inliers GNC dropped), and refine once more.
+    std::vector<WeightLoss>& w = problem.weights();
+    for (size_t k = 0; k < w.size(); ++k) w[k].weight = out.inlier[k] ? 1.0 : 0.0;
+    run(options.max_iterations);
+    for (int round = 0; round < 5; ++round) {
+      const std::vector<double> r2 = problem.SquaredResiduals();
+      out.rejected = 0;
+      bool changed = false;
+      for (size_t k = 0; k < r2.size(); ++k) {
+        if (!IsLoopClosure(graph.edges[k])) continue;
+        const bool keep = r2[k] < options.gnc_threshold;
+        changed = changed || keep != out.inlier[k];
+        out.inlier[k] = keep;
+        w[k].weight = keep ? 1.0 : 0.0;
+        out.rejected += keep ? 0 : 1;
+      }
+      if (!changed) break;
+      run(options.max_iterations);
+    }
+  } else {
+    run(options.max_iterations);
+    if (options.outliers == OutlierHandling::kCauchy) {
+      // Classify: a loop closure is rejected if its Cauchy weight fell below
+      // 1/10, i.e. |r|^2 > 9 c^2.
+      const std::vector<double> r2 = problem.SquaredResiduals();
+      const double c2 = options.cauchy_scale * options.cauchy_scale;
+      for (size_t k = 0; k < r2.size(); ++k) {
+        if (IsLoopClosure(graph.edges[k]) && r2[k] > 9.0 * c2) {
+          out.inlier[k] = false;
+          ++out.rejected;
+        }
+      }
+    }
+  }
+  problem.FromParameters();
+  out.solve_time_s = Seconds(solve_start);
+  out.total_time_s = Seconds(start);
+  out.F = SeSyncObjective(graph);
+  out.chi2 = Chi2Objective(graph);
+  return out;
+}
+
+}  // namespace rover::mapping

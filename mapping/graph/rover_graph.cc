@@ -1,0 +1,363 @@
+#include "mapping/graph/rover_graph.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <array>
+#include <chrono>
+#include <deque>
+#include <set>
+
+#include "core/geometry/so3.h"
+#include "mapping/graph/pose_manifold.h"
+#include "mapping/graph/relative_pose_3d_cost.h"
+
+namespace rover::mapping {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+Matrix6d CheckedInverse(const Matrix6d& covariance, const std::string& what) {
+  if (!covariance.allFinite()) throw GraphError("NaN input: covariance of " + what);
+  const Eigen::LLT<Matrix6d> llt(0.5 * (covariance + covariance.transpose()));
+  if (llt.info() != Eigen::Success) {
+    throw GraphError("covariance of " + what + " is not positive definite");
+  }
+  return llt.solve(Matrix6d::Identity());
+}
+
+void CheckFinite(const Eigen::Isometry3d& T, const std::string& what) {
+  if (!T.matrix().allFinite()) throw GraphError("NaN input: measurement of " + what);
+}
+
+}  // namespace
+
+Matrix6d InformationFromCovariance(const Eigen::Isometry3d& T_a_b, const Matrix6d& covariance) {
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = T_a_b.linear().transpose();
+  J.bottomRightCorner<3, 3>() = 0.5 * Eigen::Matrix3d::Identity();
+  return CheckedInverse(J * covariance * J.transpose(), "a measurement");
+}
+
+std::pair<Eigen::Isometry3d, Matrix6d> ComposeDetection(const RobotDetection& d) {
+  const Eigen::Isometry3d T = d.T_body_cam * d.T_cam_marker * d.T_body_marker.inverse();
+  // Perturb T_cam_marker = (p + dp, R Exp(dth)); with u = -R_B^T t_B:
+  //   dt_T = R_A (dp - R_M [u]x dth),  dth_T = R_B dth.
+  const Eigen::Matrix3d RA = d.T_body_cam.linear();
+  const Eigen::Matrix3d RM = d.T_cam_marker.linear();
+  const Eigen::Matrix3d RB = d.T_body_marker.linear();
+  const Eigen::Vector3d u = -RB.transpose() * d.T_body_marker.translation();
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = RA;
+  J.topRightCorner<3, 3>() = -RA * RM * skew(u);
+  J.bottomRightCorner<3, 3>() = RB;
+  return {T, J * d.covariance_cam_marker * J.transpose()};
+}
+
+RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
+  RoverGraphOptions o;
+  o.cauchy_scale = node.GetInRange<double>("cauchy_scale", 1e-3, 1e3, o.cauchy_scale);
+  o.frame_switch_roll_pitch_sigma_rad = node.GetInRange<double>(
+      "frame_switch_roll_pitch_sigma_rad", 1e-9, 0.1, o.frame_switch_roll_pitch_sigma_rad);
+  o.max_iterations = node.GetInRange<int>("max_iterations", 1, 10000, o.max_iterations);
+  o.num_threads = node.GetInRange<int>("num_threads", 1, 256, o.num_threads);
+  o.compute_origin_covariances =
+      node.Get<bool>("compute_origin_covariances", o.compute_origin_covariances);
+  return o;
+}
+
+struct RoverGraph::Variable {
+  std::array<double, 7> x{0, 0, 0, 0, 0, 0, 1};
+  bool initialized = false;
+  bool in_problem = false;
+};
+
+struct RoverGraph::Factor {
+  GraphKey a;
+  std::optional<GraphKey> b;  // Empty for a prior.
+  Eigen::Isometry3d Z = Eigen::Isometry3d::Identity();
+  Matrix6d information = Matrix6d::Identity();
+  bool robust = false;
+  bool in_problem = false;
+};
+
+class RoverGraph::Impl {
+ public:
+  explicit Impl(const RoverGraphOptions& options)
+      : options_(options), cauchy_(options.cauchy_scale) {
+    ceres::Problem::Options po;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem_ = std::make_unique<ceres::Problem>(po);
+  }
+
+  void Add(Factor f, const Matrix6d& covariance, const std::string& what) {
+    CheckFinite(f.Z, what);
+    (void)CheckedInverse(covariance, what);
+    f.information = InformationFromCovariance(f.Z, covariance);
+    variables_[f.a];
+    if (f.b) variables_[*f.b];
+    factors_.push_back(std::move(f));
+  }
+
+  void Initialise() {
+    std::map<GraphKey, std::vector<size_t>> adjacency;
+    std::deque<GraphKey> queue;
+    bool has_prior = false;
+    for (size_t k = 0; k < factors_.size(); ++k) {
+      const Factor& f = factors_[k];
+      if (!f.b) {
+        has_prior = true;
+        Variable& v = variables_.at(f.a);
+        if (!v.initialized) {
+          PoseToParameters(f.Z, v.x.data());
+          v.initialized = true;
+        }
+        continue;
+      }
+      adjacency[f.a].push_back(k);
+      adjacency[*f.b].push_back(k);
+    }
+    if (!has_prior) {
+      throw GraphError(
+          "gauge problem: the graph has no prior; add a prior on each robot's first origin");
+    }
+    for (const auto& [key, v] : variables_) {
+      if (v.initialized) queue.push_back(key);
+    }
+    while (!queue.empty()) {
+      const GraphKey key = queue.front();
+      queue.pop_front();
+      const Eigen::Isometry3d T = PoseFromParameters(variables_.at(key).x.data());
+      for (const size_t k : adjacency[key]) {
+        const Factor& f = factors_[k];
+        const bool forward = f.a == key;
+        Variable& other = variables_.at(forward ? *f.b : f.a);
+        if (other.initialized) continue;
+        PoseToParameters(
+            forward ? Eigen::Isometry3d(T * f.Z) : Eigen::Isometry3d(T * f.Z.inverse()),
+            other.x.data());
+        other.initialized = true;
+        queue.push_back(forward ? *f.b : f.a);
+      }
+    }
+    std::vector<std::string> loose;
+    for (const auto& [key, v] : variables_) {
+      if (!v.initialized) loose.push_back(key.ToString());
+    }
+    if (!loose.empty()) {
+      std::string names;
+      for (size_t k = 0; k < loose.size() && k < 10; ++k) names += (k ? ", " : "") + loose[k];
+      if (loose.size() > 10) names += ", ...";
+      throw GraphError("gauge problem: " + std::to_string(loose.size()) +
+                       " variable(s) not connected to any prior (unanchored component): " + names);
+    }
+  }
+
+  RoverGraphSummary Optimize() {
+    RoverGraphSummary out;
+    Initialise();
+    for (auto& [key, v] : variables_) {
+      if (v.in_problem) continue;
+      problem_->AddParameterBlock(v.x.data(), 7, &manifold_);
+      v.in_problem = true;
+    }
+    for (Factor& f : factors_) {
+      if (f.in_problem) continue;
+      ceres::LossFunction* loss = f.robust ? &cauchy_ : nullptr;
+      double* a = variables_.at(f.a).x.data();
+      if (f.b) {
+        problem_->AddResidualBlock(new RelativePose3dCost(f.Z, f.information), loss, a,
+                                   variables_.at(*f.b).x.data());
+      } else {
+        problem_->AddResidualBlock(new PosePrior3dCost(f.Z, f.information), loss, a);
+      }
+      f.in_problem = true;
+    }
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    so.sparse_linear_algebra_library_type =
+        ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ? ceres::SUITE_SPARSE
+                                                                              : ceres::EIGEN_SPARSE;
+    so.max_num_iterations = options_.max_iterations;
+    so.num_threads = options_.num_threads;
+    so.function_tolerance = 1e-12;
+    so.gradient_tolerance = 1e-12;
+    so.parameter_tolerance = 1e-12;
+    so.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    const Clock::time_point start = Clock::now();
+    ceres::Solve(so, problem_.get(), &summary);
+    out.solve_time_s = Seconds(start);
+    out.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    out.initial_cost = summary.initial_cost;
+    out.final_cost = summary.final_cost;
+    out.converged = summary.termination_type == ceres::CONVERGENCE;
+    out.variables = static_cast<int>(variables_.size());
+    out.factors = static_cast<int>(factors_.size());
+    origin_covariance_.clear();
+    if (options_.compute_origin_covariances) {
+      const Clock::time_point cov_start = Clock::now();
+      ComputeOriginCovariances();
+      out.covariance_time_s = Seconds(cov_start);
+    }
+    return out;
+  }
+
+  void ComputeOriginCovariances() {
+    ceres::Covariance::Options co;
+    co.num_threads = options_.num_threads;
+    co.algorithm_type = ceres::SPARSE_QR;
+    ceres::Covariance covariance(co);
+    std::vector<std::pair<const double*, const double*>> blocks;
+    for (const auto& [key, v] : variables_) {
+      if (key.type == GraphKey::Type::kOrigin) blocks.emplace_back(v.x.data(), v.x.data());
+    }
+    if (!covariance.Compute(blocks, problem_.get())) {
+      throw GraphError("origin covariances: the problem is rank deficient (gauge problem?)");
+    }
+    for (const auto& [key, v] : variables_) {
+      if (key.type != GraphKey::Type::kOrigin) continue;
+      Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
+      covariance.GetCovarianceBlockInTangentSpace(v.x.data(), v.x.data(), C.data());
+      origin_covariance_[key] = C;
+    }
+  }
+
+  const RoverGraphOptions options_;
+  PoseManifold manifold_;
+  ceres::CauchyLoss cauchy_;
+  std::map<GraphKey, Variable> variables_;
+  std::vector<Factor> factors_;
+  std::map<GraphKey, Matrix6d> origin_covariance_;
+  struct FilterPose {
+    int64_t submap = 0;
+    int64_t pose = 0;
+    Eigen::Isometry3d T_local_body = Eigen::Isometry3d::Identity();
+  };
+  std::map<int, FilterPose> current_filter_pose_;
+  std::map<int, FilterPose> latest_v_;
+  std::unique_ptr<ceres::Problem> problem_;  // Declared last: destroyed first.
+};
+
+RoverGraph::RoverGraph(const RoverGraphOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+
+RoverGraph::~RoverGraph() = default;
+
+void RoverGraph::AddPrior(const GraphKey& key, const Eigen::Isometry3d& T_world_key,
+                          const Matrix6d& covariance) {
+  Factor f;
+  f.a = key;
+  f.Z = T_world_key;
+  impl_->Add(std::move(f), covariance, "prior on " + key.ToString());
+}
+
+void RoverGraph::AddBetween(const GraphKey& a, const GraphKey& b, const Eigen::Isometry3d& T_a_b,
+                            const Matrix6d& covariance, bool robust) {
+  if (a == b) throw GraphError("factor between " + a.ToString() + " and itself");
+  Factor f;
+  f.a = a;
+  f.b = b;
+  f.Z = T_a_b;
+  f.robust = robust;
+  impl_->Add(std::move(f), covariance, "factor " + a.ToString() + " -> " + b.ToString());
+}
+
+void RoverGraph::AddOriginPrior(int robot, const Eigen::Isometry3d& T_world_origin,
+                                const Matrix6d& covariance) {
+  AddPrior(GraphKey::Origin(robot, 0), T_world_origin, covariance);
+}
+
+void RoverGraph::AddFrameSwitch(int robot, int64_t submap, const Eigen::Isometry3d& T_old_new,
+                                const Matrix4d& covariance) {
+  // Expand [dp; dyaw] to [dp; dtheta]: for a rotation about z, a right
+  // perturbation about z is an additive yaw change, so dtheta_z = dyaw; roll
+  // and pitch get the stiff prior.
+  Matrix6d C = Matrix6d::Zero();
+  const int map[4] = {0, 1, 2, 5};
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) C(map[r], map[c]) = covariance(r, c);
+  }
+  const double s2 = impl_->options_.frame_switch_roll_pitch_sigma_rad *
+                    impl_->options_.frame_switch_roll_pitch_sigma_rad;
+  C(3, 3) = s2;
+  C(4, 4) = s2;
+  AddBetween(GraphKey::Origin(robot, submap), GraphKey::Origin(robot, submap + 1), T_old_new, C,
+             false);
+}
+
+void RoverGraph::AddFilterPose(int robot, int64_t submap, int64_t pose,
+                               const Eigen::Isometry3d& T_local_body, const Matrix6d& covariance) {
+  AddBetween(GraphKey::Origin(robot, submap), GraphKey::Pose(robot, pose), T_local_body, covariance,
+             false);
+  auto it = impl_->latest_v_.find(robot);
+  if (it == impl_->latest_v_.end() || pose >= it->second.pose) {
+    impl_->latest_v_[robot] = {submap, pose, T_local_body};
+  }
+}
+
+void RoverGraph::AddSubmapMatch(int robot_a, int64_t submap_a, int robot_b, int64_t submap_b,
+                                const Eigen::Isometry3d& T_a_b, const Matrix6d& covariance) {
+  AddBetween(GraphKey::Origin(robot_a, submap_a), GraphKey::Origin(robot_b, submap_b), T_a_b,
+             covariance, true);
+}
+
+void RoverGraph::AddRobotDetection(int observer, int64_t observer_pose, int target,
+                                   int64_t target_pose, const RobotDetection& detection) {
+  const auto [T, C] = ComposeDetection(detection);
+  AddBetween(GraphKey::Pose(observer, observer_pose), GraphKey::Pose(target, target_pose), T, C,
+             true);
+}
+
+void RoverGraph::AddLandmarkObservation(int robot, int64_t pose, int64_t landmark,
+                                        const Eigen::Isometry3d& T_body_landmark,
+                                        const Matrix6d& covariance) {
+  AddBetween(GraphKey::Pose(robot, pose), GraphKey::Landmark(landmark), T_body_landmark, covariance,
+             true);
+}
+
+void RoverGraph::SetCurrentFilterPose(int robot, int64_t submap,
+                                      const Eigen::Isometry3d& T_local_body) {
+  CheckFinite(T_local_body, "current filter pose");
+  impl_->current_filter_pose_[robot] = {submap, 0, T_local_body};
+}
+
+RoverGraphSummary RoverGraph::Optimize() { return impl_->Optimize(); }
+
+Eigen::Isometry3d RoverGraph::Estimate(const GraphKey& key) const {
+  const auto it = impl_->variables_.find(key);
+  if (it == impl_->variables_.end() || !it->second.initialized) {
+    throw GraphError("no estimate for " + key.ToString());
+  }
+  return PoseFromParameters(it->second.x.data());
+}
+
+Matrix6d RoverGraph::OriginCovariance(int robot, int64_t submap) const {
+  const GraphKey key = GraphKey::Origin(robot, submap);
+  const auto it = impl_->origin_covariance_.find(key);
+  if (it == impl_->origin_covariance_.end()) {
+    throw GraphError("no covariance for " + key.ToString());
+  }
+  return it->second;
+}
+
+Eigen::Isometry3d RoverGraph::GlobalPose(int robot) const {
+  auto it = impl_->current_filter_pose_.find(robot);
+  if (it == impl_->current_filter_pose_.end()) it = impl_->latest_v_.find(robot);
+  if (it == impl_->latest_v_.end()) {
+    throw GraphError("no filter pose for robot " + std::to_string(robot));
+  }
+  return Origin(robot, it->second.submap) * it->second.T_local_body;
+}
+
+std::vector<GraphKey> RoverGraph::Keys() const {
+  std::vector<GraphKey> keys;
+  for (const auto& [key, v] : impl_->variables_) keys.push_back(key);
+  return keys;
+}
+
+}  // namespace rover::mapping
