@@ -327,6 +327,65 @@ TEST(LocalReferenceFilterTest, ZeroVelocityUpdatesOnlyWhenWheelsStandStill) {
   EXPECT_EQ(f.output().status & kStatusStandstill, 0u);
 }
 
+TEST(LocalReferenceFilterTest, ZeroVelocityWaitsUntilTheWheelsStoodStillForAWholeWindow) {
+  // The IMU is still but the wheels only stop at 2.0 s (as at the end of a
+  // turn, when the IMU window still holds the slowing rotation).
+  StaticImu imu(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), 1.0, 9);
+  LocalReferenceFilter f(DefaultOptions(), nullptr);
+  const double window_s = f.options().zupt.window_s;
+  uint64_t zupts_at_stop = 0;
+  Time first_zupt = Time::Max();
+  for (int k = 0; k < 1400; ++k) {
+    const Time t = At(k * kPeriodNs);
+    const double rate = t < AtSeconds(2.0) ? 0.3 : 0.0;
+    if (k % 4 == 0) f.AddWheelSpeeds({t, {rate, rate, rate, rate}});
+    f.AddImu(imu.At(t));
+    if (t == AtSeconds(2.0)) zupts_at_stop = f.health().zero_velocity_updates;
+    if (first_zupt == Time::Max() && f.health().zero_velocity_updates > zupts_at_stop &&
+        t > AtSeconds(2.0)) {
+      first_zupt = t;
+    }
+  }
+  EXPECT_EQ(zupts_at_stop, 0u);
+  ASSERT_NE(first_zupt, Time::Max());
+  EXPECT_GT((first_zupt - AtSeconds(2.0)).ToSeconds(), window_s - 0.011);
+  EXPECT_LT((first_zupt - AtSeconds(2.0)).ToSeconds(), window_s + 0.02);
+}
+
+TEST(LocalReferenceFilterTest, EvictionKeepsTheNewestKeyframe) {
+  DriftSetup d;
+  EskfOptions o = DefaultOptions();
+  // Triggers every 0.1 s from 1.5 s; measurements every frame, keyframes at
+  // 1.5 s and 1.8 s; then five frames whose measurements never come (VO
+  // stalled): they and the old keyframe compete for six slots.
+  for (int i = 0; i < 4; ++i) d.filter.AddCloneTrigger({AtSeconds(1.5 + 0.1 * i)});
+  d.RunTo(1.95);
+  const auto kf = [&](double from, double to, bool keyframe) {
+    RelativePoseMeasurement z = d.NoMotion(AtSeconds(from), AtSeconds(to), AtSeconds(1.95));
+    z.to_is_keyframe = keyframe;
+    d.filter.AddRelativePose(z);
+  };
+  kf(1.5, 1.6, false);
+  kf(1.5, 1.7, false);
+  kf(1.5, 1.8, true);
+  ASSERT_EQ(d.filter.state().clone_count, 2);  // keyframes 1.5 and 1.8
+  for (int i = 0; i < 6; ++i) d.filter.AddCloneTrigger({AtSeconds(2.0 + 0.1 * i)});
+  d.RunTo(2.6);
+  const FilterState& s = d.filter.state();
+  ASSERT_EQ(s.clone_count, o.clones.max_clones);
+  bool newest_keyframe_kept = false;
+  for (int i = 0; i < s.clone_count; ++i) {
+    newest_keyframe_kept |= s.clones[static_cast<size_t>(i)].stamp == AtSeconds(1.8);
+    EXPECT_NE(s.clones[static_cast<size_t>(i)].stamp, AtSeconds(1.5));  // the old keyframe went
+  }
+  EXPECT_TRUE(newest_keyframe_kept);
+  EXPECT_EQ(d.filter.health().clones_evicted, 2u);
+  // The VO catches up from its newest keyframe: accepted.
+  RelativePoseMeasurement z = d.NoMotion(AtSeconds(1.8), AtSeconds(2.5), AtSeconds(2.6));
+  d.filter.AddRelativePose(z);
+  EXPECT_EQ(d.filter.health().Accepted(InputKind::kRelativePose), 4u);
+}
+
 TEST(LocalReferenceFilterTest, FrameSwitchAndPoseReportThroughTheFilter) {
   DriftSetup d;
   d.RunTo(2.0);
