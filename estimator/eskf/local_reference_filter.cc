@@ -377,7 +377,8 @@ void LocalReferenceFilter::ApplyWheelAverage() {
     last_numerical_ = s.core.stamp;
     Reject(s.core.stamp, InputKind::kWheelSpeeds, RejectReason::kNumerical);
   } else if (out.gated) {
-    Reject(s.core.stamp, InputKind::kWheelSpeeds, RejectReason::kGated, out.mahalanobis_sq, 0.0);
+    Reject(s.core.stamp, InputKind::kWheelSpeeds, RejectReason::kGated, out.mahalanobis_sq,
+           wheel_updater_.gate());
   } else {
     last_aiding_ = s.core.stamp;
   }

@@ -51,6 +51,7 @@ class WheelOdometryUpdater {
                        const Eigen::Vector3d& gyro_rad_s) const;
 
   int dof() const { return dof_; }
+  double gate() const { return gate_; }
 
  private:
   WheelOdometryOptions options_;
