@@ -5,12 +5,15 @@
 #include <vector>
 
 #include "host/eval/ate_command.h"
+#include "host/eval/nees_command.h"
+#include "host/eval/sim_command.h"
 #include "host/eval/subcommand.h"
 
 int main(int argc, char** argv) {
   namespace eval = rover::host::eval;
   CLI::App app{
-      "rover-eval: evaluate estimated trajectories against ground truth.\n"
+      "rover-eval: evaluate estimated trajectories against ground truth, and the local\n"
+      "reference filter on the simulator (sim: accuracy, nees: Monte Carlo consistency).\n"
       "Reads TUM files, EuRoC and OpenVINS CSVs and rover flight logs (MCAP, with the\n"
       "estimator's frame switches chained). Exit status: 0 ok, 1 a check failed,\n"
       "2 bad usage or unusable input."};
@@ -20,6 +23,8 @@ int main(int argc, char** argv) {
   // One line per subcommand; each lives in its own *_command.{h,cc}.
   const std::vector<eval::Subcommand> subcommands = {
       eval::AddAteCommand(app),
+      eval::AddNeesCommand(app),
+      eval::AddSimCommand(app),
   };
 
   try {
