@@ -55,4 +55,9 @@ function(rover_add_test)
     "  set_tests_properties(\${${ARG_NAME}_TESTS} PROPERTIES ${properties})\n"
     "endif()\n")
   set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${script}")
+  # Remembered per label so tests/CMakeLists.txt can make one target per
+  # sanitizer label: the sanitizer presets build only what they run.
+  foreach(label IN LISTS ARG_LABELS)
+    set_property(GLOBAL APPEND PROPERTY ROVER_TESTS_LABELLED_${label} ${ARG_NAME})
+  endforeach()
 endfunction()
