@@ -1,16 +1,20 @@
 // bench_graph: time to converge on the standard pose-graph datasets, next to
 // the published SE-Sync optima and GTSAM times; optionally the outlier study.
 //
-// usage: bench_graph [--data DIR] [--outliers]
+// usage: bench_graph [--data DIR] [--outliers] [--helmert] [--outlier-case FILE FRACTION]
 //   DIR defaults to $ROVER_SHARED_DIR/data/posegraph (or the configured one).
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
 
+#include "mapping/graph/chordal_initialisation.h"
 #include "mapping/graph/g2o_reader.h"
+#include "mapping/graph/helmert_block_solver.h"
 #include "mapping/graph/outlier_injection.h"
 #include "mapping/graph/pose_graph_solver.h"
 #include "mapping/graph/se_sync_objective.h"
@@ -38,14 +42,23 @@ constexpr Dataset kDatasets[] = {{"sphere2500.g2o", 1.687e3, 0.704},
 void Solve(const std::string& dir, const Dataset& d) {
   const PoseGraph original = rover::mapping::ReadG2oFile(dir + "/" + d.file);
   for (const Objective objective : {Objective::kSeSync, Objective::kChi2}) {
+    // Reference in the same run: the same solve with Ceres's default
+    // trust-region radius (1e4), otherwise identical.
+    PoseGraph r = original;
+    PoseGraphSolverOptions ro;
+    ro.objective = objective;
+    ro.initial_trust_region_radius = 1e4;
+    const PoseGraphSolverSummary ref = rover::mapping::SolvePoseGraph(r, ro);
     PoseGraph g = original;
     PoseGraphSolverOptions o;
     o.objective = objective;
     const PoseGraphSolverSummary s = rover::mapping::SolvePoseGraph(g, o);
     const bool sesync = objective == Objective::kSeSync;
-    std::printf("%-20s %-7s iters %3d  init %6.3f s  total %6.3f s  (GTSAM PDL %5.3f s)  F %.6e",
-                d.file, sesync ? "sesync" : "chi2", s.iterations, s.init_time_s, s.total_time_s,
-                d.gtsam_s, s.F);
+    std::printf(
+        "%-20s %-7s iters %3d  init %6.3f s  total %6.3f s  (radius 1e4: %2d it %6.3f s, x%.2f)  "
+        "(GTSAM PDL %5.3f s)  F %.6e",
+        d.file, sesync ? "sesync" : "chi2", s.iterations, s.init_time_s, s.total_time_s,
+        ref.iterations, ref.total_time_s, ref.total_time_s / s.total_time_s, d.gtsam_s, s.F);
     if (sesync) {
       std::printf("  published %.3e  rel %.1e", d.published_F,
                   std::abs(s.F - d.published_F) / d.published_F);
@@ -56,13 +69,14 @@ void Solve(const std::string& dir, const Dataset& d) {
   }
 }
 
-void Outliers(const std::string& dir, const char* file, double fraction) {
+void Outliers(const std::string& dir, const char* file, double fraction, bool with_cauchy) {
   const PoseGraph clean = rover::mapping::ReadG2oFile(dir + "/" + file);
   PoseGraphSolverOptions o;
   o.objective = Objective::kSeSync;
   PoseGraph reference = clean;
   const double F0 = rover::mapping::SolvePoseGraph(reference, o).F;
   for (const OutlierHandling handling : {OutlierHandling::kCauchy, OutlierHandling::kGnc}) {
+    if (handling == OutlierHandling::kCauchy && !with_cauchy) continue;
     PoseGraph g = clean;
     const size_t inliers = g.edges.size();
     const int injected = rover::mapping::InjectFalseLoopClosures(g, fraction, 1);
@@ -84,6 +98,52 @@ void Outliers(const std::string& dir, const char* file, double fraction) {
   }
 }
 
+// Helmert blocking vs the full Ceres solve from the same chordal start
+// (chi2 objective). Memory: bytes of factor values + indices (see
+// HelmertBlockSummary), not process RSS.
+void Helmert(const std::string& dir, const char* file, int block_size,
+             rover::mapping::HelmertPartition partition) {
+  PoseGraph start = rover::mapping::ReadG2oFile(dir + "/" + file);
+  rover::mapping::ChordalInitialisation(start);
+  start.vertices_implied = false;
+  PoseGraph full = start;
+  PoseGraph blocked = start;
+  PoseGraphSolverOptions o;
+  o.initialisation = rover::mapping::Initialisation::kFile;
+  o.function_tolerance = 1e-12;
+  o.gradient_tolerance = 1e-12;
+  o.parameter_tolerance = 1e-12;
+  const PoseGraphSolverSummary f = rover::mapping::SolvePoseGraph(full, o);
+  const std::size_t full_bytes = rover::mapping::FullNormalFactorBytes(start, Objective::kChi2);
+  rover::mapping::HelmertBlockOptions h;
+  h.block_size = block_size;
+  h.partition = partition;
+  h.function_tolerance = 1e-12;
+  const rover::mapping::HelmertBlockSummary s =
+      rover::mapping::HelmertBlockSolver(h).Solve(blocked);
+  double max_dt = 0.0;
+  for (size_t v = 0; v < full.vertices.size(); ++v) {
+    max_dt = std::max(
+        max_dt,
+        (full.vertices[v].pose.translation() - blocked.vertices[v].pose.translation()).norm());
+  }
+  std::printf(
+      "%-20s %-10s blocks of <= %4d: %3d blocks, %5d separator / %5d interior poses, %3d LM steps\n"
+      "    full Ceres %.3f s cost %.9e | Helmert %.3f s (eliminate %.3f, separator %.3f, back "
+      "%.3f) "
+      "cost %.9e (rel %.1e), max |dt| %.1e\n"
+      "    memory: full sparse factor %.2f MB | Helmert largest block %.2f MB, all blocks %.2f MB, "
+      "separator factor %.2f MB\n",
+      file, partition == rover::mapping::HelmertPartition::kSpatial ? "spatial" : "contiguous",
+      block_size, s.blocks, s.separator_vertices, s.interior_vertices, s.iterations, f.solve_time_s,
+      f.final_cost, s.time_s, s.eliminate_time_s, s.separator_time_s, s.back_time_s, s.final_cost,
+      std::abs(s.final_cost - f.final_cost) / f.final_cost, max_dt,
+      static_cast<double>(full_bytes) / 1e6, static_cast<double>(s.largest_block_bytes) / 1e6,
+      static_cast<double>(s.all_blocks_bytes) / 1e6,
+      static_cast<double>(s.separator_factor_bytes) / 1e6);
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -91,23 +151,49 @@ int main(int argc, char** argv) {
   if (const char* env = std::getenv("ROVER_SHARED_DIR")) dir = std::string(env) + "/data/posegraph";
   if (dir.empty()) dir = ROVER_GRAPH_BENCH_DATA;
   bool outliers = false;
+  bool helmert = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--data") == 0 && i + 1 < argc) {
       dir = argv[++i];
     } else if (std::strcmp(argv[i], "--outliers") == 0) {
       outliers = true;
+    } else if (std::strcmp(argv[i], "--helmert") == 0) {
+      helmert = true;
+    } else if (std::strcmp(argv[i], "--outlier-case") == 0 && i + 2 < argc) {
+      const std::string file = argv[i + 1];
+      const double fraction = std::atof(argv[i + 2]);
+      i += 2;
+      if (dir.empty()) dir = ROVER_GRAPH_BENCH_DATA;
+      Outliers(dir, file.c_str(), fraction, false);
+      return 0;
     } else {
-      std::fprintf(stderr, "usage: bench_graph [--data DIR] [--outliers]\n");
+      std::fprintf(stderr,
+                   "usage: bench_graph [--data DIR] [--outliers] [--helmert] [--outlier-case FILE "
+                   "FRACTION]\n");
       return 2;
     }
   }
   try {
     std::printf("== Pose graph: time to converge (chordal init + LM, SuiteSparse, 2 threads)\n");
     for (const Dataset& d : kDatasets) Solve(dir, d);
+    if (helmert) {
+      std::printf("\n== Helmert blocking vs full solve (chi2, 2 threads)\n");
+      using rover::mapping::HelmertPartition;
+      const char* which = std::getenv("ROVER_HELMERT_ONLY");  // Optional file filter.
+      for (const char* file : {"intel.g2o", "parking-garage.g2o", "sphere2500.g2o"}) {
+        if (which != nullptr && std::strcmp(which, file) != 0) continue;
+        for (const int size : {100, 250}) {
+          for (const HelmertPartition p :
+               {HelmertPartition::kSpatial, HelmertPartition::kContiguous}) {
+            Helmert(dir, file, size, p);
+          }
+        }
+      }
+    }
     if (outliers) {
       std::printf("\n== Pose graph: random false loop closures (seeded)\n");
       for (const char* file : {"manhattan.g2o", "sphere2500.g2o"}) {
-        for (const double fraction : {0.1, 0.3}) Outliers(dir, file, fraction);
+        for (const double fraction : {0.1, 0.3}) Outliers(dir, file, fraction, true);
       }
     }
   } catch (const std::exception& e) {

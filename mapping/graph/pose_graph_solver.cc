@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <stdexcept>
 
 #include "mapping/graph/chordal_initialisation.h"
 #include "mapping/graph/chordal_pose_2d_cost.h"
@@ -27,7 +28,7 @@ double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-// rho(s) = w * s with a weight that GNC changes between solves.
+// rho(s) = w s with a weight that GNC changes between solves.
 class WeightLoss final : public ceres::LossFunction {
  public:
   void Evaluate(double s, double rho[3]) const override {
@@ -55,7 +56,12 @@ class ProgressCallback final : public ceres::IterationCallback {
 // The Ceres problem of one g2o graph: one parameter block per vertex.
 class Problem {
  public:
-  Problem(PoseGraph& graph, const PoseGraphSolverOptions& options)
+  // Only edges with (*active)[k] true (all if null) get a residual block, so
+  // rejected edges cost nothing (not even fill-in).
+  // `loop_losses` (if given, one per edge) replace the options' loss on loop
+  // closures.
+  Problem(PoseGraph& graph, const PoseGraphSolverOptions& options,
+          const std::vector<bool>* active = nullptr, std::vector<WeightLoss>* loop_losses = nullptr)
       : graph_(graph), options_(options), planar_(graph.dimension == 2) {
     ceres::Problem::Options po;
     po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -76,17 +82,18 @@ class Problem {
     problem_->SetParameterBlockConstant(Block(0));
     const auto index = VertexIndex(graph);
     cauchy_ = std::make_unique<ceres::CauchyLoss>(options.cauchy_scale);
-    weights_.resize(graph.edges.size());
+    residual_ids_.assign(graph.edges.size(), nullptr);
     for (size_t k = 0; k < graph.edges.size(); ++k) {
+      if (active != nullptr && !(*active)[k]) continue;
       const PoseEdge& e = graph.edges[k];
       double* bi = Block(static_cast<size_t>(index.at(e.from)));
       double* bj = Block(static_cast<size_t>(index.at(e.to)));
       ceres::LossFunction* loss = nullptr;
       if (IsLoopClosure(e)) {
         if (options.outliers == OutlierHandling::kCauchy) loss = cauchy_.get();
-        if (options.outliers == OutlierHandling::kGnc) loss = &weights_[k];
+        if (loop_losses != nullptr) loss = &(*loop_losses)[k];
       }
-      residual_ids_.push_back(problem_->AddResidualBlock(MakeCost(e), loss, bi, bj));
+      residual_ids_[k] = problem_->AddResidualBlock(MakeCost(e), loss, bi, bj);
     }
   }
 
@@ -131,6 +138,7 @@ class Problem {
                              : (options_.objective == Objective::kSeSync ? 12 : 6);
     std::vector<double> r(static_cast<size_t>(size));
     for (size_t k = 0; k < residual_ids_.size(); ++k) {
+      if (residual_ids_[k] == nullptr) continue;
       double cost = 0.0;
       problem_->EvaluateResidualBlock(residual_ids_[k], false, &cost, r.data(), nullptr);
       double s = 0.0;
@@ -144,8 +152,11 @@ class Problem {
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     so.sparse_linear_algebra_library_type =
-        ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ? ceres::SUITE_SPARSE
-                                                                              : ceres::EIGEN_SPARSE;
+        !options_.eigen_sparse &&
+                ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)
+            ? ceres::SUITE_SPARSE
+            : ceres::EIGEN_SPARSE;
+    so.jacobi_scaling = options_.jacobi_scaling;
     so.trust_region_strategy_type = options_.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
     so.initial_trust_region_radius = options_.initial_trust_region_radius;
 
@@ -163,8 +174,6 @@ class Problem {
     return summary;
   }
 
-  std::vector<WeightLoss>& weights() { return weights_; }
-
  private:
   PoseGraph& graph_;
   const PoseGraphSolverOptions& options_;
@@ -173,7 +182,6 @@ class Problem {
   std::vector<double> params_;
   PoseManifold manifold_;
   std::unique_ptr<ceres::CauchyLoss> cauchy_;
-  std::vector<WeightLoss> weights_;
   std::vector<ceres::ResidualBlockId> residual_ids_;
   std::unique_ptr<ceres::Problem> problem_;  // Destroyed first: it points at the above.
 };
@@ -197,11 +205,17 @@ PoseGraphSolverOptions PoseGraphSolverOptions::Load(const ConfigNode& node) {
                                               {"gnc", OutlierHandling::kGnc}},
                                              o.outliers);
   o.cauchy_scale = node.GetInRange<double>("cauchy_scale", 1e-6, 1e6, o.cauchy_scale);
-  o.gnc_threshold = node.GetInRange<double>("gnc_threshold", 1e-6, 1e9, o.gnc_threshold);
+  o.gnc_threshold = node.GetInRange<double>("gnc_threshold", 0.0, 1e9, o.gnc_threshold);
+  o.outlier_confidence =
+      node.GetInRange<double>("outlier_confidence", 0.5, 1.0 - 1e-12, o.outlier_confidence);
   o.gnc_step = node.GetInRange<double>("gnc_step", 1.01, 10.0, o.gnc_step);
   o.dogleg = node.GetEnum<bool>("trust_region", {{"lm", false}, {"dogleg", true}}, o.dogleg);
   o.initial_trust_region_radius = node.GetInRange<double>("initial_trust_region_radius", 1e-6, 1e16,
                                                           o.initial_trust_region_radius);
+  o.eigen_sparse =
+      node.GetEnum<bool>("sparse_library", {{"auto", false}, {"eigen", true}}, o.eigen_sparse);
+  o.jacobi_scaling =
+      node.GetEnum<bool>("jacobi_scaling", {{"true", true}, {"false", false}}, o.jacobi_scaling);
   o.max_iterations = node.GetInRange<int>("max_iterations", 1, 100000, o.max_iterations);
   o.num_threads = node.GetInRange<int>("num_threads", 1, 256, o.num_threads);
   o.function_tolerance =
@@ -213,28 +227,84 @@ PoseGraphSolverOptions PoseGraphSolverOptions::Load(const ConfigNode& node) {
   return o;
 }
 
+double ChiSquaredQuantile(int dof, double p) {
+  if (dof < 1 || !(p > 0.0 && p < 1.0)) {
+    throw std::invalid_argument("ChiSquaredQuantile: need dof >= 1 and 0 < p < 1");
+  }
+  // Upper tail Q(x) = P(chi2_dof > x) in closed form: even dof,
+  // exp(-x/2) sum_{k < dof/2} (x/2)^k / k!; odd dof,
+  // erfc(sqrt(x/2)) + exp(-x/2) sum_{k=1}^{(dof-1)/2} (x/2)^(k-1/2) / Gamma(k + 1/2).
+  auto upper_tail = [dof](double x) {
+    const double h = 0.5 * x;
+    double sum = 0.0;
+    if (dof % 2 == 0) {
+      double term = 1.0;
+      for (int k = 0; k < dof / 2; ++k) {
+        sum += term;
+        term *= h / (k + 1);
+      }
+      return std::exp(-h) * sum;
+    }
+    double term = std::sqrt(h) / std::tgamma(1.5);
+    for (int k = 1; k <= (dof - 1) / 2; ++k) {
+      sum += term;
+      term *= h / (k + 0.5);
+    }
+    return std::erfc(std::sqrt(h)) + std::exp(-h) * sum;
+  };
+  double lo = 0.0;
+  double hi = 1.0;
+  while (upper_tail(hi) > 1.0 - p) hi *= 2.0;
+  for (int it = 0; it < 200 && hi - lo > 1e-12 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (upper_tail(mid) > 1.0 - p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+double InlierThreshold(int dimension, double confidence) {
+  return dimension == 2 ? 2.0 * ChiSquaredQuantile(3, confidence)
+                        : 4.0 * ChiSquaredQuantile(6, confidence);
+}
+
+namespace {
+
+double GncThreshold(const PoseGraph& graph, const PoseGraphSolverOptions& options) {
+  return options.gnc_threshold > 0.0 ? options.gnc_threshold
+                                     : InlierThreshold(graph.dimension, options.outlier_confidence);
+}
+
+// F term of every edge at the current vertex poses.
+std::vector<double> EdgeTerms(const PoseGraph& graph) {
+  const auto index = VertexIndex(graph);
+  std::vector<double> r2(graph.edges.size(), 0.0);
+  for (size_t k = 0; k < graph.edges.size(); ++k) {
+    const PoseEdge& e = graph.edges[k];
+    r2[k] = SeSyncEdgeTerm(e, graph.dimension,
+                           graph.vertices[static_cast<size_t>(index.at(e.from))].pose,
+                           graph.vertices[static_cast<size_t>(index.at(e.to))].pose);
+  }
+  return r2;
+}
+
+}  // namespace
+
 std::vector<bool> RobustChordalInitialisation(PoseGraph& graph,
-                                              const PoseGraphSolverOptions& options) {
+                                              const PoseGraphSolverOptions& options, int* steps) {
   // Graduated non-convexity with the Geman-McClure surrogate (Yang et al.
   // 2020) around the chordal relaxation: each step is one weighted linear
   // chordal solve; loop-closure weights w = (mu c^2 / (r^2 + mu c^2))^2 with
   // r^2 the edge's F term; mu shrinks from "almost least squares" to 1.
+  // Odometry edges are trusted (weight 1). A weight below 1e-9 is set to
+  // exactly 0 so the edge leaves the sparsity pattern (outliers join distant
+  // poses and cause most of the fill-in); it is re-evaluated every step.
   CheckGaugeAndFinite(graph);
-  const double c2 = options.gnc_threshold;
+  const double c2 = GncThreshold(graph, options);
   std::vector<double> weights(graph.edges.size(), 1.0);
-  const auto index = VertexIndex(graph);
-  auto residuals = [&] {
-    std::vector<double> r2(graph.edges.size(), 0.0);
-    for (size_t k = 0; k < graph.edges.size(); ++k) {
-      const PoseEdge& e = graph.edges[k];
-      r2[k] = SeSyncEdgeTerm(e, graph.dimension,
-                             graph.vertices[static_cast<size_t>(index.at(e.from))].pose,
-                             graph.vertices[static_cast<size_t>(index.at(e.to))].pose);
-    }
-    return r2;
-  };
+  int count = 0;
   ChordalInitialisation(graph, &weights);
-  std::vector<double> r2 = residuals();
+  ++count;
+  std::vector<double> r2 = EdgeTerms(graph);
   double max_r2 = 0.0;
   for (size_t k = 0; k < r2.size(); ++k) {
     if (IsLoopClosure(graph.edges[k])) max_r2 = std::max(max_r2, r2[k]);
@@ -244,10 +314,11 @@ std::vector<bool> RobustChordalInitialisation(PoseGraph& graph,
     for (size_t k = 0; k < r2.size(); ++k) {
       if (!IsLoopClosure(graph.edges[k])) continue;
       const double a = mu * c2 / (r2[k] + mu * c2);
-      weights[k] = a * a;
+      weights[k] = a * a < 1e-9 ? 0.0 : a * a;
     }
     ChordalInitialisation(graph, &weights);
-    r2 = residuals();
+    ++count;
+    r2 = EdgeTerms(graph);
     if (mu <= 1.0) break;
     mu = std::max(1.0, mu / options.gnc_step);
   }
@@ -257,6 +328,8 @@ std::vector<bool> RobustChordalInitialisation(PoseGraph& graph,
   }
   for (size_t k = 0; k < r2.size(); ++k) weights[k] = inlier[k] ? 1.0 : 0.0;
   ChordalInitialisation(graph, &weights);
+  ++count;
+  if (steps != nullptr) *steps = count;
   return inlier;
 }
 
@@ -284,9 +357,8 @@ PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOpt
   const Clock::time_point solve_start = Clock::now();
   for (const PoseEdge& e : graph.edges) out.loop_closures += IsLoopClosure(e) ? 1 : 0;
 
-  Problem problem(graph, options);
   bool first = true;
-  auto run = [&](int max_iterations) {
+  auto run = [&](Problem& problem, int max_iterations) {
     const ceres::Solver::Summary s = problem.Solve(max_iterations, start);
     if (first) out.initial_cost = s.initial_cost;
     first = false;
@@ -297,29 +369,69 @@ PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOpt
   };
 
   if (options.outliers == OutlierHandling::kGnc) {
-    // The GNC weights came from the robust chordal initialisation; refine on
-    // the kept edges, re-classify every loop closure at the refined solution
-    // (re-admitting inliers GNC dropped), and refine once more.
-    std::vector<WeightLoss>& w = problem.weights();
-    for (size_t k = 0; k < w.size(); ++k) w[k].weight = out.inlier[k] ? 1.0 : 0.0;
-    run(options.max_iterations);
+    // Refine on the edges GNC kept (rejected ones are not in the problem),
+    // re-admit near-consistent loop closures (below), then classify every
+    // loop closure by its F term (inlier iff below c^2), refine on the
+    // inliers, and repeat until the set is stable.
+    const double c2 = GncThreshold(graph, options);
+    {
+      Problem problem(graph, options, &out.inlier);
+      run(problem, options.max_iterations);
+      problem.FromParameters();
+    }
+    // Re-admission: the chordal GNC drops some true loop closures (the
+    // chordal estimate is only approximate); at the refined, outlier-free
+    // estimate they are near-consistent, outliers are not. Candidates are the
+    // loop closures whose end-of-schedule GNC weight (c^2 / (r^2 + c^2))^2 is
+    // at least 1e-4 (the rest would carry < 1e-4 of an inlier's information;
+    // leaving them out keeps the random long-range outliers out of the
+    // sparsity pattern). GNC (Geman-McClure on the F terms) then runs again
+    // over the candidates, each step a short warm-started nonlinear solve of
+    // the weighted F.
+    {
+      std::vector<double> r2 = EdgeTerms(graph);
+      std::vector<bool> candidate(graph.edges.size(), true);
+      double max_r2 = 0.0;
+      for (size_t k = 0; k < r2.size(); ++k) {
+        if (!IsLoopClosure(graph.edges[k])) continue;
+        candidate[k] = r2[k] < 99.0 * c2;
+        if (candidate[k]) max_r2 = std::max(max_r2, r2[k]);
+      }
+      PoseGraphSolverOptions sesync = options;
+      sesync.objective = Objective::kSeSync;
+      std::vector<WeightLoss> weights(graph.edges.size());
+      Problem problem(graph, sesync, &candidate, &weights);
+      for (double mu = std::max(1.0, 2.0 * max_r2 / c2);;
+           mu = std::max(1.0, mu / options.gnc_step)) {
+        for (size_t k = 0; k < r2.size(); ++k) {
+          const double a = mu * c2 / (r2[k] + mu * c2);
+          weights[k].weight = a * a;
+        }
+        run(problem, 20);
+        problem.FromParameters();
+        r2 = EdgeTerms(graph);
+        if (mu <= 1.0) break;
+      }
+    }
     for (int round = 0; round < 5; ++round) {
-      const std::vector<double> r2 = problem.SquaredResiduals();
+      const std::vector<double> r2 = EdgeTerms(graph);
       out.rejected = 0;
       bool changed = false;
       for (size_t k = 0; k < r2.size(); ++k) {
         if (!IsLoopClosure(graph.edges[k])) continue;
-        const bool keep = r2[k] < options.gnc_threshold;
+        const bool keep = r2[k] < c2;
         changed = changed || keep != out.inlier[k];
         out.inlier[k] = keep;
-        w[k].weight = keep ? 1.0 : 0.0;
         out.rejected += keep ? 0 : 1;
       }
-      if (!changed) break;
-      run(options.max_iterations);
+      if (!changed && round > 0) break;
+      Problem problem(graph, options, &out.inlier);
+      run(problem, options.max_iterations);
+      problem.FromParameters();
     }
   } else {
-    run(options.max_iterations);
+    Problem problem(graph, options);
+    run(problem, options.max_iterations);
     if (options.outliers == OutlierHandling::kCauchy) {
       // Classify: a loop closure is rejected if its Cauchy weight fell below
       // 1/10, i.e. |r|^2 > 9 c^2.
@@ -332,8 +444,8 @@ PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOpt
         }
       }
     }
+    problem.FromParameters();
   }
-  problem.FromParameters();
   out.solve_time_s = Seconds(solve_start);
   out.total_time_s = Seconds(start);
   out.F = SeSyncObjective(graph);
