@@ -1,0 +1,49 @@
+#ifndef ROVER_ESTIMATOR_VO_TEMPORAL_TRACKER_H_
+#define ROVER_ESTIMATOR_VO_TEMPORAL_TRACKER_H_
+
+// Tracks features from a reference (keyframe) image into the current image by
+// pyramidal KLT, then back again: a track is kept only when the backward track
+// lands within `max_fb_error_px` of where it started (forward-backward check)
+// and the point stays inside the image.
+
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+namespace rover::estimator::vo {
+
+struct TemporalTrackerOptions {
+  int window_px = 21;      ///< KLT window side
+  int pyramid_levels = 3;  ///< levels above the base
+  int max_iterations = 30;
+  double max_fb_error_px = 0.5;
+  int border_px = 2;  ///< tracks closer to the edge are dropped
+};
+
+/// Result of one Track() call, index-aligned with the input points.
+struct TrackResult {
+  std::vector<cv::Point2f> points;     ///< position in the current image
+  std::vector<unsigned char> tracked;  ///< 1: track kept
+  int lost = 0;                        ///< KLT failed or left the image
+  int fb_rejected = 0;                 ///< failed the forward-backward check
+  int kept = 0;
+};
+
+class TemporalTracker {
+ public:
+  explicit TemporalTracker(const TemporalTrackerOptions& options = {}) : options_(options) {}
+
+  /// Tracks `ref_points` of `ref` into `cur` (8-bit grey, same size). Bad
+  /// input (empty, wrong type or size) yields a result with nothing tracked.
+  TrackResult Track(const cv::Mat& ref, const cv::Mat& cur,
+                    const std::vector<cv::Point2f>& ref_points) const;
+
+  const TemporalTrackerOptions& options() const { return options_; }
+
+ private:
+  TemporalTrackerOptions options_;
+};
+
+}  // namespace rover::estimator::vo
+
+#endif  // ROVER_ESTIMATOR_VO_TEMPORAL_TRACKER_H_

@@ -1,0 +1,113 @@
+#include "estimator/vo/stereo_rectifier.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+
+#include "core/geometry/so3.h"
+
+namespace rover::estimator::vo {
+namespace {
+
+// EuRoC V1 calibration (cam0, cam1 sensor.yaml), as plain numbers.
+CameraModel EurocCam(int index) {
+  CameraModel c;
+  c.width_px = 752;
+  c.height_px = 480;
+  Eigen::Matrix4d m;
+  if (index == 0) {
+    c.intrinsics = {458.654, 457.296, 367.215, 248.375};
+    c.distortion = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+    m << 0.0148655429818, -0.999880929698, 0.00414029679422, -0.0216401454975, 0.999557249008,
+        0.0149672133247, 0.025715529948, -0.064676986768, -0.0257744366974, 0.00375618835797,
+        0.999660727178, 0.00981073058949, 0.0, 0.0, 0.0, 1.0;
+  } else {
+    c.intrinsics = {457.587, 456.134, 379.999, 255.238};
+    c.distortion = {-0.28368365, 0.07451284, -0.00010473, -3.55590700e-05};
+    m << 0.0125552670891, -0.999755099723, 0.0182237714554, -0.0198435579556, 0.999598781151,
+        0.0130119051815, 0.0251588363115, 0.0453689425024, -0.0253898008918, 0.0179005838253,
+        0.999517347078, 0.00786212447038, 0.0, 0.0, 0.0, 1.0;
+  }
+  c.T_body_cam.matrix() = m;
+  return c;
+}
+
+// Projects a body-frame point into a raw (distorted) camera image.
+Eigen::Vector2d ProjectRaw(const CameraModel& c, const Eigen::Vector3d& p_body) {
+  const Eigen::Vector3d p = c.T_body_cam.inverse() * p_body;
+  std::vector<cv::Point3d> in = {{p.x(), p.y(), p.z()}};
+  std::vector<cv::Point2d> out;
+  const cv::Matx33d k(c.intrinsics[0], 0, c.intrinsics[2], 0, c.intrinsics[1], c.intrinsics[3], 0,
+                      0, 1);
+  const cv::Vec4d d(c.distortion[0], c.distortion[1], c.distortion[2], c.distortion[3]);
+  cv::projectPoints(in, cv::Vec3d::zeros(), cv::Vec3d::zeros(), k, d, out);
+  return {out[0].x, out[0].y};
+}
+
+TEST(StereoRectifierTest, EurocGeometry) {
+  const CameraModel c0 = EurocCam(0), c1 = EurocCam(1);
+  const auto rect = StereoRectifier::Create(c0, c1);
+  ASSERT_TRUE(rect.has_value());
+  EXPECT_NEAR(rect->baseline_m(), 0.110, 0.002);
+  EXPECT_GT(rect->intrinsics().fx, 300.0);
+  EXPECT_EQ(rect->intrinsics().fx, rect->intrinsics().fy);
+  // The rectified frame is only slightly rotated from cam0.
+  const Eigen::Matrix3d R = rect->T_cam0rect_body().linear() * c0.T_body_cam.linear();
+  EXPECT_LT(LogSO3(R).norm(), 0.05);
+  EXPECT_LT((rect->T_body_cam0rect().translation() - c0.T_body_cam.translation()).norm(), 1e-9);
+
+  // A body point projected through the raw cameras and rectified lands where
+  // the rectified model predicts, on the same row in both images.
+  cv::Mat raw0 = cv::Mat::zeros(480, 752, CV_8UC1), raw1 = raw0.clone();
+  const Eigen::Vector3d p_body = c0.T_body_cam * Eigen::Vector3d(0.3, -0.2, 3.0);
+  const Eigen::Vector2d u0 = ProjectRaw(c0, p_body), u1 = ProjectRaw(c1, p_body);
+  cv::circle(raw0,
+             cv::Point(static_cast<int>(std::lround(u0.x() * 16)),
+                       static_cast<int>(std::lround(u0.y() * 16))),
+             4 * 16, cv::Scalar(255), cv::FILLED, cv::LINE_AA, 4);
+  cv::circle(raw1,
+             cv::Point(static_cast<int>(std::lround(u1.x() * 16)),
+                       static_cast<int>(std::lround(u1.y() * 16))),
+             4 * 16, cv::Scalar(255), cv::FILLED, cv::LINE_AA, 4);
+  cv::Mat r0, r1;
+  ASSERT_TRUE(rect->Rectify(raw0, raw1, &r0, &r1));
+  const auto centroid = [](const cv::Mat& m) {
+    const cv::Moments mo = cv::moments(m);
+    return Eigen::Vector2d(mo.m10 / mo.m00, mo.m01 / mo.m00);
+  };
+  const Eigen::Vector3d p = rect->T_cam0rect_body() * p_body;
+  const auto& k = rect->intrinsics();
+  const Eigen::Vector2d expected0(k.fx * p.x() / p.z() + k.cx, k.fy * p.y() / p.z() + k.cy);
+  const Eigen::Vector2d expected1(k.fx * (p.x() - rect->baseline_m()) / p.z() + k.cx,
+                                  expected0.y());
+  EXPECT_LT((centroid(r0) - expected0).norm(), 0.3);
+  EXPECT_LT((centroid(r1) - expected1).norm(), 0.3);
+}
+
+TEST(StereoRectifierTest, RejectsBadCalibrationAndImages) {
+  CameraModel c0 = EurocCam(0), c1 = EurocCam(1);
+  CameraModel same = c0;
+  EXPECT_FALSE(StereoRectifier::Create(c0, same).has_value());
+  CameraModel small = c1;
+  small.width_px = 640;
+  EXPECT_FALSE(StereoRectifier::Create(c0, small).has_value());
+  CameraModel no_focal = c1;
+  no_focal.intrinsics[0] = 0.0;
+  EXPECT_FALSE(StereoRectifier::Create(c0, no_focal).has_value());
+
+  const auto rect = StereoRectifier::Create(c0, c1);
+  ASSERT_TRUE(rect.has_value());
+  cv::Mat out0, out1;
+  const cv::Mat good = cv::Mat::zeros(480, 752, CV_8UC1);
+  EXPECT_FALSE(rect->Rectify(good, cv::Mat(), &out0, &out1));
+  EXPECT_FALSE(rect->Rectify(cv::Mat::zeros(480, 640, CV_8UC1), good, &out0, &out1));
+  EXPECT_FALSE(rect->Rectify(good, cv::Mat::zeros(480, 752, CV_16UC1), &out0, &out1));
+  EXPECT_FALSE(rect->RectifyOne(2, good, &out0));
+  EXPECT_TRUE(rect->Rectify(good, good, &out0, &out1));
+}
+
+}  // namespace
+}  // namespace rover::estimator::vo
