@@ -238,31 +238,9 @@ Subcommand AddNeesCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--seed", o.seed, "seed of the first run")->capture_default_str();
-  cmd->add_option("--preset", o.setup.preset, "synthetic VO noise preset")
-      ->check(CLI::IsMember({"ideal-consistent", "realistic"}))
-      ->capture_default_str();
-  cmd->add_option("--wheels", state->wheels, "wheel speeds into the filter")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
+  AddSimSetupOptions(cmd, &o.setup, &state->wheels, &o.jobs);
   cmd->add_option("--confidence", o.confidence, "two-sided confidence of the bounds")
       ->check(CLI::Range(0.5, 0.9999))
-      ->capture_default_str();
-  cmd->add_option("--jobs", o.jobs, "runs in parallel threads (results do not depend on it)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  cmd->add_option("--duration-s", o.setup.max_duration_s, "simulated seconds (0: whole route)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  cmd->add_option("--switch-distance-m", o.setup.switch_distance_m,
-                  "frame switch every D metres driven (0: never)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  cmd->add_flag("--imu-white-only", o.setup.imu_white_only,
-                "simulate the IMU without scale-factor and misalignment errors");
-  cmd->add_option("--vo-cov-inflation", o.setup.vo_covariance_inflation,
-                  "scale the VO covariance the filter assumes (1: as stated; <1 makes the "
-                  "filter overconfident)")
-      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--grid-step-s", o.grid_step_s, "time step of the per-step comparison [s]")
       ->check(CLI::PositiveNumber)

@@ -540,6 +540,33 @@ int RunSim(const SimCommandOptions& options, std::ostream& out, std::ostream& er
   return all_initialised ? kExitOk : kExitCheckFailed;
 }
 
+void AddSimSetupOptions(CLI::App* cmd, SimSetup* setup, std::string* wheels, int* jobs) {
+  cmd->add_option("--jobs", *jobs, "runs in parallel threads (results do not depend on it)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--preset", setup->preset, "synthetic VO noise preset")
+      ->check(CLI::IsMember({"ideal-consistent", "realistic"}))
+      ->capture_default_str();
+  cmd->add_option("--wheels", *wheels, "wheel speeds into the filter")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--switch-distance-m", setup->switch_distance_m,
+                  "frame switch every D metres driven (0: never)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--duration-s", setup->max_duration_s, "simulated seconds (0: whole route)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--imu-white-only", setup->imu_white_only,
+                "simulate the IMU without scale-factor and misalignment errors (the filter's "
+                "own error model)");
+  cmd->add_option("--vo-cov-inflation", setup->vo_covariance_inflation,
+                  "scale the VO covariance the filter assumes (1: as stated; <1 makes the "
+                  "filter overconfident)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
 Subcommand AddSimCommand(CLI::App& app) {
   struct State {
     SimCommandOptions options;
@@ -562,31 +589,9 @@ Subcommand AddSimCommand(CLI::App& app) {
   cmd->add_option("--runs", o.runs, "number of runs (seeds S, S+1, ...)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--jobs", o.jobs, "runs in parallel threads (results do not depend on it)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  cmd->add_option("--preset", o.setup.preset, "synthetic VO noise preset")
-      ->check(CLI::IsMember({"ideal-consistent", "realistic"}))
-      ->capture_default_str();
-  cmd->add_option("--wheels", state->wheels, "wheel speeds into the filter")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
-  cmd->add_option("--switch-distance-m", o.setup.switch_distance_m,
-                  "frame switch every D metres driven (0: never)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  cmd->add_option("--duration-s", o.setup.max_duration_s, "simulated seconds (0: whole route)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  AddSimSetupOptions(cmd, &o.setup, &state->wheels, &o.jobs);
   cmd->add_option("--drop", o.setup.drop_probability, "VO frame drop probability")
       ->check(CLI::Range(0.0, 0.99))
-      ->capture_default_str();
-  cmd->add_flag("--imu-white-only", o.setup.imu_white_only,
-                "simulate the IMU without scale-factor and misalignment errors (the filter's "
-                "own error model)");
-  cmd->add_option("--vo-cov-inflation", o.setup.vo_covariance_inflation,
-                  "scale the VO covariance the filter assumes (1: as stated)")
-      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--segments", o.segments_m, "RPE segment lengths [m], comma-separated")
       ->delimiter(',')

@@ -69,6 +69,10 @@ sim::Scenario LoadSimScenario(const SimSetup& setup);
 sim::FilterFeedOptions SimFeedOptions(const SimSetup& setup);
 /// EskfOptionsForFeed(feed) with setup's VO covariance inflation.
 estimator::EskfOptions SimFilterOptions(const sim::FilterFeed& feed, const SimSetup& setup);
+/// Registers the options both simulator commands share on `cmd`: --preset,
+/// --wheels (into `*wheels`, "on"/"off"), --jobs (into `*jobs`),
+/// --switch-distance-m, --duration-s, --imu-white-only, --vo-cov-inflation.
+void AddSimSetupOptions(CLI::App* cmd, SimSetup* setup, std::string* wheels, int* jobs);
 /// The seed of run `run` (0-based) under the command's base seed: base + run.
 uint64_t RunSeed(uint64_t base_seed, int run);
 /// The note about the wheel model's fixed seed (empty when wheels are off).
