@@ -19,3 +19,6 @@ echo "== Local reference filter"
 echo
 echo "== Pose graph (bench_graph; add --outliers for the false-loop-closure study)"
 "$build/bench/graph/bench_graph"
+echo
+echo "== Stereo matching on EuRoC (bench_stereo_matcher)"
+"$build/bench/vo/bench_stereo_matcher"

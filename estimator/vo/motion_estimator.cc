@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -36,7 +37,8 @@ MotionEstimator::MotionEstimator(const RectifiedIntrinsics& intrinsics, double b
 
 bool MotionEstimator::ReprojectionResidual(const Eigen::Isometry3d& T_cur_ref,
                                            const StereoObservation& obs, Eigen::Vector4d* residual,
-                                           Matrix46d* jacobian) const {
+                                           Matrix46d* jacobian,
+                                           Eigen::Matrix<double, 4, 3>* point_jacobian) const {
   const Eigen::Vector3d p = T_cur_ref * obs.p_ref;
   if (!(p.z() > 1e-6)) return false;
   const double iz = 1.0 / p.z();
@@ -51,8 +53,9 @@ bool MotionEstimator::ReprojectionResidual(const Eigen::Isometry3d& T_cur_ref,
     r(2) = 0.0;
     r(3) = 0.0;
   }
-  if (jacobian != nullptr) {
-    // d(pixel)/d(p) for both cameras, times d(p)/d(xi) = [I, -skew(p)].
+  if (jacobian != nullptr || point_jacobian != nullptr) {
+    // d(pixel)/d(p) for both cameras, times d(p)/d(xi) = [I, -skew(p)]
+    // (pose) or d(p)/d(p_ref) = R (point).
     Eigen::Matrix<double, 4, 3> dproj = Eigen::Matrix<double, 4, 3>::Zero();
     dproj(0, 0) = k_.fx * iz;
     dproj(0, 2) = -k_.fx * p.x() * iz * iz;
@@ -63,10 +66,13 @@ bool MotionEstimator::ReprojectionResidual(const Eigen::Isometry3d& T_cur_ref,
       dproj(2, 2) = -k_.fx * xr * iz * iz;
       dproj.row(3) = dproj.row(1);
     }
-    Eigen::Matrix<double, 3, 6> dp;
-    dp.leftCols<3>().setIdentity();
-    dp.rightCols<3>() = -skew(p);
-    *jacobian = dproj * dp;
+    if (jacobian != nullptr) {
+      Eigen::Matrix<double, 3, 6> dp;
+      dp.leftCols<3>().setIdentity();
+      dp.rightCols<3>() = -skew(p);
+      *jacobian = dproj * dp;
+    }
+    if (point_jacobian != nullptr) *point_jacobian = dproj * T_cur_ref.linear();
   }
   return true;
 }
@@ -92,16 +98,42 @@ double MotionEstimator::Spread(const std::vector<StereoObservation>& observation
   return n / static_cast<double>(g * g);
 }
 
+Eigen::Matrix4d MotionEstimator::ObservationWeight(const Eigen::Isometry3d& T_cur_ref,
+                                                   const StereoObservation& obs) const {
+  // Residual covariance S = sigma_px^2 I + Jp Cov(p_ref) Jp^T; the weight is
+  // its inverse over the rows the observation has.
+  Eigen::Vector4d r;
+  Eigen::Matrix<double, 4, 3> Jp;
+  Eigen::Matrix4d W = Eigen::Matrix4d::Zero();
+  if (!ReprojectionResidual(T_cur_ref, obs, &r, nullptr, &Jp)) return W;
+  const double pixel_var = options_.pixel_sigma_px * options_.pixel_sigma_px;
+  const Eigen::Matrix4d S =
+      pixel_var * Eigen::Matrix4d::Identity() + Jp * obs.p_ref_covariance * Jp.transpose();
+  if (obs.has_right) {
+    W = S.inverse();
+  } else {
+    W.topLeftCorner<2, 2>() = S.topLeftCorner<2, 2>().inverse();
+  }
+  return W;
+}
+
 int MotionEstimator::Refine(const std::vector<StereoObservation>& observations,
                             const std::vector<int>& indices, Eigen::Isometry3d* T_cur_ref) const {
+  // Weights fixed at the starting pose, so that every iteration minimises
+  // the same cost (they change little over the refinement).
+  std::vector<Eigen::Matrix4d> weights;
+  weights.reserve(indices.size());
+  for (int i : indices) {
+    weights.push_back(ObservationWeight(*T_cur_ref, observations[static_cast<size_t>(i)]));
+  }
   const auto cost_of = [&](const Eigen::Isometry3d& T) {
     double c = 0.0;
     Eigen::Vector4d r;
-    for (int i : indices) {
-      if (!ReprojectionResidual(T, observations[static_cast<size_t>(i)], &r)) {
+    for (size_t k = 0; k < indices.size(); ++k) {
+      if (!ReprojectionResidual(T, observations[static_cast<size_t>(indices[k])], &r)) {
         return std::numeric_limits<double>::infinity();
       }
-      c += r.squaredNorm();
+      c += r.dot(weights[k] * r);
     }
     return c;
   };
@@ -113,10 +145,14 @@ int MotionEstimator::Refine(const std::vector<StereoObservation>& observations,
     Vector6d g = Vector6d::Zero();
     Eigen::Vector4d r;
     Matrix46d J;
-    for (int i : indices) {
-      if (!ReprojectionResidual(*T_cur_ref, observations[static_cast<size_t>(i)], &r, &J)) continue;
-      H.noalias() += J.transpose() * J;
-      g.noalias() += J.transpose() * r;
+    for (size_t k = 0; k < indices.size(); ++k) {
+      if (!ReprojectionResidual(*T_cur_ref, observations[static_cast<size_t>(indices[k])], &r,
+                                &J)) {
+        continue;
+      }
+      const Matrix46d WJ = weights[k] * J;
+      H.noalias() += J.transpose() * WJ;
+      g.noalias() += WJ.transpose() * r;
     }
     bool improved = false;
     Vector6d step = Vector6d::Zero();
@@ -142,6 +178,7 @@ int MotionEstimator::Refine(const std::vector<StereoObservation>& observations,
 
 MotionEstimate MotionEstimator::Estimate(const std::vector<StereoObservation>& observations) const {
   MotionEstimate out;
+  const auto t_start = std::chrono::steady_clock::now();
   out.observations = static_cast<int>(observations.size());
   const int n = out.observations;
   if (n < std::max(options_.min_inliers, 4)) return out;
@@ -212,6 +249,14 @@ MotionEstimate MotionEstimator::Estimate(const std::vector<StereoObservation>& o
     }
   }
   out.ransac_iterations = it;
+  const auto t_ransac = std::chrono::steady_clock::now();
+  out.ransac_ms = std::chrono::duration<double, std::milli>(t_ransac - t_start).count();
+  // Timings are reported, never used in a decision (determinism).
+  const auto stop_refine_clock = [&] {
+    out.refine_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_ransac)
+            .count();
+  };
   if (static_cast<int>(best_inliers.size()) < options_.min_inliers) return out;
 
   // Refine on the RANSAC inliers, re-select inliers with the refined pose, refine again.
@@ -223,23 +268,28 @@ MotionEstimate MotionEstimator::Estimate(const std::vector<StereoObservation>& o
   if (static_cast<int>(inliers.size()) < options_.min_inliers) return out;
   out.lm_iterations += Refine(observations, inliers, &best);
 
-  Matrix6d H = Matrix6d::Zero();
+  // Covariance of the weighted fit: (sum J^T W J)^-1, scaled up when the
+  // whitened residuals are larger than the noise model says (never down).
   double sum_sq = 0.0;
+  double chi2 = 0.0;
   int rows = 0;
+  Matrix6d H = Matrix6d::Zero();
   Eigen::Vector4d r;
   Matrix46d J;
   for (int i : inliers) {
     const StereoObservation& o = observations[static_cast<size_t>(i)];
     if (!ReprojectionResidual(best, o, &r, &J)) continue;
-    H.noalias() += J.transpose() * J;
+    const Eigen::Matrix4d W = ObservationWeight(best, o);
+    H.noalias() += J.transpose() * W * J;
     sum_sq += r.squaredNorm();
+    chi2 += r.dot(W * r);
     rows += o.has_right ? 4 : 2;
   }
   if (rows <= 6) return out;
   const Eigen::FullPivLU<Matrix6d> lu(H);
   if (!lu.isInvertible()) return out;
-  const double sigma2 = std::max(sum_sq / static_cast<double>(rows - 6),
-                                 options_.min_residual_sigma_px * options_.min_residual_sigma_px);
+  out.residual_scale = std::sqrt(std::max(chi2 / static_cast<double>(rows - 6), 1.0));
+  const Matrix6d covariance = out.residual_scale * out.residual_scale * lu.inverse();
   out.rms_error_px = std::sqrt(sum_sq / static_cast<double>(rows));
   out.spread = Spread(observations, inliers);
   double inflation = 1.0;
@@ -251,11 +301,12 @@ MotionEstimate MotionEstimator::Estimate(const std::vector<StereoObservation>& o
     inflation *= options_.good_spread / std::max(out.spread, 1e-3);
   }
   out.inflation = inflation;
-  out.covariance = sigma2 * inflation * lu.inverse();
+  out.covariance = inflation * options_.covariance_scale * covariance;
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
   out.T_cur_ref = best;
   out.inliers = std::move(inliers);
   out.valid = true;
+  stop_refine_clock();
   return out;
 }
 

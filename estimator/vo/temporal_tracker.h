@@ -38,9 +38,29 @@ class TemporalTracker {
   TrackResult Track(const cv::Mat& ref, const cv::Mat& cur,
                     const std::vector<cv::Point2f>& ref_points) const;
 
+  /// Builds the KLT pyramid (with derivatives) of an 8-bit grey image for
+  /// TrackPyramids(), with `window_px` borders and `levels` levels above the
+  /// base. Building it once per image saves rebuilding it in every call.
+  static void BuildPyramid(const cv::Mat& image, int window_px, int levels,
+                           std::vector<cv::Mat>* pyramid);
+
+  /// As Track(), on pyramids from BuildPyramid() (built with a window at
+  /// least `window_px` and at least `pyramid_levels` levels), starting each
+  /// point at `initial_guess` (index-aligned with ref_points; empty: at its
+  /// reference position). Bad input yields nothing tracked.
+  TrackResult TrackPyramids(const std::vector<cv::Mat>& ref_pyramid,
+                            const std::vector<cv::Mat>& cur_pyramid,
+                            const std::vector<cv::Point2f>& ref_points,
+                            const std::vector<cv::Point2f>& initial_guess = {}) const;
+
   const TemporalTrackerOptions& options() const { return options_; }
 
  private:
+  template <typename Image>
+  TrackResult TrackImpl(const Image& ref, const Image& cur, cv::Size size,
+                        const std::vector<cv::Point2f>& ref_points,
+                        const std::vector<cv::Point2f>& initial_guess) const;
+
   TemporalTrackerOptions options_;
 };
 

@@ -8,12 +8,14 @@
 #include "host/eval/nees_command.h"
 #include "host/eval/sim_command.h"
 #include "host/eval/subcommand.h"
+#include "host/eval/vio_command.h"
 
 int main(int argc, char** argv) {
   namespace eval = rover::host::eval;
   CLI::App app{
       "rover-eval: evaluate estimated trajectories against ground truth, and the local\n"
-      "reference filter on the simulator (sim: accuracy, nees: Monte Carlo consistency).\n"
+      "reference filter on the simulator (sim: accuracy, nees: Monte Carlo consistency), and\n"
+      "the stereo VO with the filter on EuRoC-layout datasets (vio).\n"
       "Reads TUM files, EuRoC and OpenVINS CSVs and rover flight logs (MCAP, with the\n"
       "estimator's frame switches chained). Exit status: 0 ok, 1 a check failed,\n"
       "2 bad usage or unusable input."};
@@ -25,6 +27,7 @@ int main(int argc, char** argv) {
       eval::AddAteCommand(app),
       eval::AddNeesCommand(app),
       eval::AddSimCommand(app),
+      eval::AddVioCommand(app),
   };
 
   try {
