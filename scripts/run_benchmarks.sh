@@ -22,3 +22,6 @@ echo "== Pose graph (bench_graph; add --outliers for the false-loop-closure stud
 echo
 echo "== Stereo matching on EuRoC (bench_stereo_matcher)"
 "$build/bench/vo/bench_stereo_matcher"
+echo
+echo "== Stereo VO per frame by stage on EuRoC (bench_stereo_odometry; pass a dataset dir for simulator data)"
+"$build/bench/vo/bench_stereo_odometry"

@@ -34,10 +34,13 @@
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/stereo_matcher.h"
 #include "estimator/vo/stereo_rectifier.h"
+#include "tests/estimator/vo/euroc_vo_util.h"
 #include "tests/estimator/vo/stereo_matcher_reference.h"
 
 namespace rover::estimator::vo {
 namespace {
+
+using testing::ToModel;
 
 constexpr int kCalls = 21;
 constexpr size_t kFrames[] = {0, 50, 80};
@@ -52,16 +55,6 @@ double MedianMs(const std::function<void()>& fn) {
   }
   std::nth_element(ms.begin(), ms.begin() + kCalls / 2, ms.end());
   return ms[kCalls / 2];
-}
-
-CameraModel ToModel(const drivers::CameraCalibration& c) {
-  CameraModel m;
-  m.width_px = c.width_px;
-  m.height_px = c.height_px;
-  m.intrinsics = c.intrinsics;
-  m.distortion = c.distortion;
-  m.T_body_cam = c.T_body_cam;
-  return m;
 }
 
 // Points of `a` that `b` accepted too, with the right pixel within 0.01 px.

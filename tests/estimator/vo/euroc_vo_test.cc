@@ -18,24 +18,17 @@
 #include "estimator/vo/stereo_matcher.h"
 #include "estimator/vo/stereo_rectifier.h"
 #include "estimator/vo/temporal_tracker.h"
+#include "tests/estimator/vo/euroc_vo_util.h"
 
 namespace rover::estimator::vo {
 namespace {
+
+using testing::ToModel;
 
 using Clock = std::chrono::steady_clock;
 
 double Ms(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-CameraModel ToModel(const drivers::CameraCalibration& c) {
-  CameraModel m;
-  m.width_px = c.width_px;
-  m.height_px = c.height_px;
-  m.intrinsics = c.intrinsics;
-  m.distortion = c.distortion;
-  m.T_body_cam = c.T_body_cam;
-  return m;
 }
 
 class EurocVoTest : public ::testing::Test {

@@ -14,20 +14,13 @@
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/stereo_matcher.h"
 #include "estimator/vo/stereo_rectifier.h"
+#include "tests/estimator/vo/euroc_vo_util.h"
 #include "tests/estimator/vo/stereo_matcher_reference.h"
 
 namespace rover::estimator::vo {
 namespace {
 
-CameraModel ToModel(const drivers::CameraCalibration& c) {
-  CameraModel m;
-  m.width_px = c.width_px;
-  m.height_px = c.height_px;
-  m.intrinsics = c.intrinsics;
-  m.distortion = c.distortion;
-  m.T_body_cam = c.T_body_cam;
-  return m;
-}
+using testing::ToModel;
 
 // Points of `a` that `b` accepted too, with the right pixel within `tolerance_px`.
 int Same(const std::vector<StereoPoint>& a, const std::vector<StereoPoint>& b, float tolerance_px) {

@@ -16,27 +16,14 @@
 #include "core/geometry/so3.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/vo/stereo_odometry.h"
+#include "tests/estimator/vo/euroc_vo_util.h"
 #include "tests/estimator/vo/vo_test_util.h"
 
 namespace rover::estimator::vo {
 namespace {
 
-CameraModel ToModel(const drivers::CameraCalibration& c) {
-  CameraModel m;
-  m.width_px = c.width_px;
-  m.height_px = c.height_px;
-  m.intrinsics = c.intrinsics;
-  m.distortion = c.distortion;
-  m.T_body_cam = c.T_body_cam;
-  return m;
-}
-
-Eigen::Isometry3d Pose(const drivers::GroundTruthState& g) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = g.q_world_body.toRotationMatrix();
-  T.translation() = g.p_world_body;
-  return T;
-}
+using testing::Pose;
+using testing::ToModel;
 
 class StereoOdometryEurocTest : public ::testing::Test {
  protected:
