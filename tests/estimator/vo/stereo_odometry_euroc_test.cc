@@ -216,6 +216,51 @@ TEST_F(StereoOdometryEurocTest, LostTrackRestartsTheChain) {
   EXPECT_EQ(next.measurement->from_stamp, f[2].capture);
 }
 
+// Driving back over the same ground: the frames played forward and then
+// backward (re-stamped, so time still increases), with keyframe limits small
+// enough for the excerpt's millimetre motion. On the way back the VO must
+// return to keyframes of the way out instead of only making new ones.
+TEST_F(StereoOdometryEurocTest, ComingBackRevisitsOlderKeyframes) {
+  StereoOdometryOptions options;
+  options.keyframes.max_translation_m = 0.0004;
+  options.keyframes.max_rotation_rad = 0.0015;
+  std::string error;
+  auto vo =
+      StereoOdometry::Create(ToModel(dataset_->cam0()), ToModel(dataset_->cam1()), options, &error);
+  ASSERT_TRUE(vo.has_value()) << error;
+  const std::vector<StereoImages>& f = *frames_;
+  std::vector<size_t> order;
+  for (size_t i = 0; i < f.size(); ++i) order.push_back(i);
+  for (size_t i = f.size(); i-- > 0;) order.push_back(i);
+  Time t = f[0].capture;
+  std::vector<Time> keyframe_stamps = {t};
+  int revisits = 0, measurements = 0;
+  for (size_t k = 0; k < order.size(); ++k) {
+    StereoImages images = f[order[k]];
+    images.capture = t;
+    t = t + Duration::Milliseconds(50);
+    const VoFrameResult r = vo->Process(images);
+    if (!r.measurement) continue;
+    ++measurements;
+    const RelativePoseMeasurement& m = *r.measurement;
+    if (r.status == VoStatus::kRevisited) {
+      ++revisits;
+      // It refers to a keyframe made earlier, not the latest one.
+      EXPECT_NE(m.from_stamp, keyframe_stamps.back());
+      EXPECT_NE(std::find(keyframe_stamps.begin(), keyframe_stamps.end(), m.from_stamp),
+                keyframe_stamps.end());
+    }
+    if (m.to_is_keyframe) keyframe_stamps.push_back(m.to_stamp);
+    EXPECT_LE(m.oldest_keyframe_stamp, m.from_stamp);
+  }
+  std::cout << "keyframes " << vo->health().keyframes << ", revisits " << revisits << "\n";
+  EXPECT_EQ(measurements, static_cast<int>(order.size()) - 1);
+  EXPECT_GT(vo->health().keyframes, 5U);
+  EXPECT_GT(revisits, 0);
+  EXPECT_EQ(vo->health().revisits, static_cast<uint64_t>(revisits));
+  EXPECT_LE(vo->keyframe_count(), 5);
+}
+
 // Without a keyframe a missing right image cannot start the VO.
 TEST_F(StereoOdometryEurocTest, NoRightImageBeforeTheFirstKeyframe) {
   StereoOdometry vo = MakeVo();

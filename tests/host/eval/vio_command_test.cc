@@ -5,8 +5,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <numbers>
@@ -468,6 +472,44 @@ TEST(VioCommandTest, RunsOnTheEurocExcerpt) {
 
   const ev::Trajectory fused = ev::ReadEurocCsvTrajectory(options.trajectory_out_path);
   EXPECT_EQ(fused.size(), run.filter_outputs);
+}
+
+// Bad frames in the stream (black exposures, a frame whose right image is
+// missing so the reader drops the pair): the VO refuses and counts them, the
+// filter rides on the IMU across the gap, and VO updates resume afterwards.
+TEST(VioCommandTest, FilterRidesOnImuAcrossBadFrames) {
+  namespace fs = std::filesystem;
+  testing::TempDir dir;
+  const fs::path copy = dir.path() / "euroc";
+  fs::create_directories(copy);
+  fs::copy(SharedEuroc() + "/mav0", copy / "mav0", fs::copy_options::recursive);
+  std::vector<fs::path> left, right;
+  for (const auto& e : fs::directory_iterator(copy / "mav0/cam0/data")) left.push_back(e.path());
+  for (const auto& e : fs::directory_iterator(copy / "mav0/cam1/data")) right.push_back(e.path());
+  std::sort(left.begin(), left.end());
+  std::sort(right.begin(), right.end());
+  ASSERT_EQ(left.size(), 95u);
+  const cv::Mat black(480, 752, CV_8UC1, cv::Scalar(0));
+  for (size_t i = 40; i < 56; ++i) ASSERT_TRUE(cv::imwrite(left[i].string(), black));
+  fs::remove(right[70]);
+
+  VioCommandOptions options = EurocOptions();
+  options.dataset_dir = copy.string();
+  std::ostringstream err;
+  const VioRun run = RunVioExperiment(options, err);
+  EXPECT_EQ(run.frames, 94u);  // the pair without a right image is left out
+  EXPECT_EQ(run.vo_health.Count(estimator::vo::VoStatus::kBlackImage), 16u);
+  EXPECT_EQ(run.vo_health.dropped_frames, 1u);
+  EXPECT_EQ(run.vo_health.restarts, 0u);
+  ASSERT_TRUE(run.filter_init_stamp.has_value());
+  // VO updates after the black section, and filter output at every capture since init.
+  const Time after_black = Time::FromNanoseconds(std::stoll(left[56].stem().string()));
+  int fused_after = 0;
+  for (const auto& m : run.measurements) fused_after += m.to_stamp >= after_black ? 1 : 0;
+  EXPECT_GT(fused_after, 20);
+  EXPECT_GT(run.filter_health.Accepted(estimator::InputKind::kRelativePose), 40u);
+  ASSERT_TRUE(run.fused_evaluation.has_value()) << run.fused_error;
+  EXPECT_LT(run.fused_evaluation->ate.position_m.rmse, 0.1);
 }
 
 TEST(VioCommandTest, MaxFramesAndNoGroundTruth) {
