@@ -321,6 +321,8 @@ std::optional<StereoOdometry::Attempt> StereoOdometry::TryRevisit(const Attempt&
   // predicted through the chained keyframe poses.
   const KeyframeOptions& k = options_.keyframes;
   const Keyframe& active = keyframes_[static_cast<size_t>(current.keyframe)];
+  const double active_score = current.motion.T_cur_ref.translation().norm() / k.max_translation_m +
+                              RotationAngleRad(current.motion.T_cur_ref) / k.max_rotation_rad;
   std::vector<std::pair<double, int>> candidates;
   for (int i = 0; i < static_cast<int>(keyframes_.size()); ++i) {
     if (i == current.keyframe) continue;
@@ -328,7 +330,9 @@ std::optional<StereoOdometry::Attempt> StereoOdometry::TryRevisit(const Attempt&
                                        keyframes_[static_cast<size_t>(i)].T_odom_cam;
     const double t = T_cur_kf.translation().norm() / k.max_translation_m;
     const double r = RotationAngleRad(T_cur_kf) / k.max_rotation_rad;
-    if (t < 1.0 && r < 1.0) candidates.emplace_back(t + r, i);
+    // Only keyframes nearer than the active one are worth a try: driving on,
+    // the older keyframes lie behind and each try would cost a KLT pass.
+    if (t < 1.0 && r < 1.0 && t + r < active_score) candidates.emplace_back(t + r, i);
   }
   std::sort(candidates.begin(), candidates.end());
   constexpr size_t kMaxTries = 2;  // bounds the extra cost of a keyframe decision
