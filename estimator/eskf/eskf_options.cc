@@ -1,5 +1,8 @@
 #include "estimator/eskf/eskf_options.h"
 
+#include <cstdio>
+#include <string>
+
 namespace rover::estimator {
 namespace {
 
@@ -132,6 +135,99 @@ EskfOptions EskfOptions::LoadFile(const std::string& path) {
   EskfOptions o = Load(root);
   root.CheckNoUnknownKeysRecursive();
   return o;
+}
+
+namespace {
+
+// Writes "  key: value" lines of one section.
+class YamlSection {
+ public:
+  YamlSection(std::string* out, const char* name) : out_(out) {
+    *out_ += std::string(name) + ":\n";
+  }
+  void Put(const char* key, double value) {
+    char text[40];
+    std::snprintf(text, sizeof(text), "%.17g", value);
+    Line(key, text);
+  }
+  void Put(const char* key, int value) { Line(key, std::to_string(value)); }
+  void Put(const char* key, bool value) { Line(key, value ? "true" : "false"); }
+  void Put(const char* key, const Eigen::Vector3d& v) {
+    char text[128];
+    std::snprintf(text, sizeof(text), "[%.17g, %.17g, %.17g]", v.x(), v.y(), v.z());
+    Line(key, text);
+  }
+
+ private:
+  void Line(const char* key, const std::string& value) {
+    *out_ += std::string("  ") + key + ": " + value + "\n";
+  }
+  std::string* out_;
+};
+
+}  // namespace
+
+std::string ToYaml(const EskfOptions& o) {
+  std::string out;
+  YamlSection imu(&out, "imu");
+  imu.Put("rate_hz", o.imu.rate_hz);
+  imu.Put("gyro_noise_density_rad_s_sqrt_hz", o.imu.gyro_noise_density_rad_s_sqrt_hz);
+  imu.Put("gyro_bias_random_walk_rad_s2_sqrt_hz", o.imu.gyro_bias_random_walk_rad_s2_sqrt_hz);
+  imu.Put("accel_noise_density_m_s2_sqrt_hz", o.imu.accel_noise_density_m_s2_sqrt_hz);
+  imu.Put("accel_bias_random_walk_m_s3_sqrt_hz", o.imu.accel_bias_random_walk_m_s3_sqrt_hz);
+  imu.Put("gyro_range_rad_s", o.imu.gyro_range_rad_s);
+  imu.Put("accel_range_m_s2", o.imu.accel_range_m_s2);
+  imu.Put("gravity_m_s2", o.imu.gravity_m_s2);
+  imu.Put("noise_inflation", o.imu.noise_inflation);
+  YamlSection init(&out, "init");
+  init.Put("window_s", o.init.window_s);
+  init.Put("accel_std_threshold_m_s2", o.init.accel_std_threshold_m_s2);
+  init.Put("gyro_std_threshold_rad_s", o.init.gyro_std_threshold_rad_s);
+  init.Put("velocity_sigma_m_s", o.init.velocity_sigma_m_s);
+  init.Put("accel_bias_sigma_m_s2", o.init.accel_bias_sigma_m_s2);
+  init.Put("gyro_bias_sigma_floor_rad_s", o.init.gyro_bias_sigma_floor_rad_s);
+  YamlSection clones(&out, "clones");
+  clones.Put("max_clones", o.clones.max_clones);
+  clones.Put("max_trigger_lateness_s", o.clones.max_trigger_lateness_s);
+  clones.Put("stamp_tolerance_s", o.clones.stamp_tolerance_s);
+  YamlSection rp(&out, "relative_pose");
+  rp.Put("max_delay_s", o.relative_pose.max_delay_s);
+  rp.Put("gate_probability", o.relative_pose.gate_probability);
+  rp.Put("covariance_inflation", o.relative_pose.covariance_inflation);
+  const WheelOdometryOptions& w = o.wheels;
+  YamlSection wheels(&out, "wheels");
+  wheels.Put("enabled", w.enabled);
+  wheels.Put("wheel_radius_m", w.wheel_radius_m);
+  wheels.Put("track_m", w.track_m);
+  wheels.Put("yaw_scrub_factor", w.yaw_scrub_factor);
+  wheels.Put("lever_arm_body_m", w.lever_arm_body_m);
+  wheels.Put("nonholonomic_point_body_m", w.nonholonomic_point_body_m);
+  wheels.Put("slip_ratio_base", w.slip_ratio_base);
+  wheels.Put("slip_ratio_per_tilt_rad", w.slip_ratio_per_tilt_rad);
+  wheels.Put("update_period_s", w.update_period_s);
+  wheels.Put("forward_sigma_m_s", w.forward_sigma_m_s);
+  wheels.Put("forward_sigma_per_speed", w.forward_sigma_per_speed);
+  wheels.Put("slip_sigma_gain", w.slip_sigma_gain);
+  wheels.Put("use_nonholonomic", w.use_nonholonomic);
+  wheels.Put("lateral_sigma_m_s", w.lateral_sigma_m_s);
+  wheels.Put("use_yaw_rate", w.use_yaw_rate);
+  wheels.Put("yaw_rate_sigma_rad_s", w.yaw_rate_sigma_rad_s);
+  wheels.Put("max_delay_s", w.max_delay_s);
+  wheels.Put("gate_probability", w.gate_probability);
+  YamlSection zupt(&out, "zupt");
+  zupt.Put("enabled", o.zupt.enabled);
+  zupt.Put("window_s", o.zupt.window_s);
+  zupt.Put("wheel_rate_threshold_rad_s", o.zupt.wheel_rate_threshold_rad_s);
+  zupt.Put("gyro_threshold_rad_s", o.zupt.gyro_threshold_rad_s);
+  zupt.Put("accel_std_threshold_m_s2", o.zupt.accel_std_threshold_m_s2);
+  zupt.Put("allow_imu_only", o.zupt.allow_imu_only);
+  zupt.Put("velocity_sigma_m_s", o.zupt.velocity_sigma_m_s);
+  zupt.Put("period_s", o.zupt.period_s);
+  YamlSection health(&out, "health");
+  health.Put("max_imu_gap_s", o.health.max_imu_gap_s);
+  health.Put("recovery_s", o.health.recovery_s);
+  health.Put("aiding_timeout_s", o.health.aiding_timeout_s);
+  return out;
 }
 
 }  // namespace rover::estimator

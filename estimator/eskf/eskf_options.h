@@ -27,6 +27,7 @@ struct ImuNoiseOptions {
   double noise_inflation = 1.0;
 
   static ImuNoiseOptions Load(const ConfigNode& node);
+  friend bool operator==(const ImuNoiseOptions&, const ImuNoiseOptions&) = default;
 };
 
 /// Static initialisation: standstill detection and the initial covariance.
@@ -39,6 +40,7 @@ struct InitOptions {
   double gyro_bias_sigma_floor_rad_s = 2e-4;  ///< added to the window-mean uncertainty
 
   static InitOptions Load(const ConfigNode& node);
+  friend bool operator==(const InitOptions&, const InitOptions&) = default;
 };
 
 /// Stochastic cloning.
@@ -51,6 +53,7 @@ struct CloneOptions {
   double stamp_tolerance_s = 1e-4;
 
   static CloneOptions Load(const ConfigNode& node);
+  friend bool operator==(const CloneOptions&, const CloneOptions&) = default;
 };
 
 /// Delayed relative-pose (VO) updates.
@@ -60,6 +63,7 @@ struct RelativePoseOptions {
   double covariance_inflation = 1.0;  ///< scales the stated covariance
 
   static RelativePoseOptions Load(const ConfigNode& node);
+  friend bool operator==(const RelativePoseOptions&, const RelativePoseOptions&) = default;
 };
 
 /// Wheel odometry: body-frame forward (and lateral) velocity from four wheels.
@@ -93,6 +97,7 @@ struct WheelOdometryOptions {
   double gate_probability = 0.999;
 
   static WheelOdometryOptions Load(const ConfigNode& node);
+  friend bool operator==(const WheelOdometryOptions&, const WheelOdometryOptions&) = default;
 };
 
 /// Zero-velocity updates at standstill.
@@ -110,6 +115,7 @@ struct ZuptOptions {
       0.25;  ///< one update per period while standing (>= window: independent windows)
 
   static ZuptOptions Load(const ConfigNode& node);
+  friend bool operator==(const ZuptOptions&, const ZuptOptions&) = default;
 };
 
 /// Bad-input handling and health.
@@ -119,6 +125,7 @@ struct HealthOptions {
   double aiding_timeout_s = 2.0;  ///< kStatusNoAiding after this long without aiding
 
   static HealthOptions Load(const ConfigNode& node);
+  friend bool operator==(const HealthOptions&, const HealthOptions&) = default;
 };
 
 /// Everything the local reference filter needs.
@@ -138,7 +145,14 @@ struct EskfOptions {
   /// Loads a whole file whose top level is the estimator section and rejects
   /// unknown keys.
   static EskfOptions LoadFile(const std::string& path);
+
+  friend bool operator==(const EskfOptions&, const EskfOptions&) = default;
 };
+
+/// The options as YAML text that Load() reads back to equal options: every
+/// key is written, numbers with 17 significant digits (exact round trip).
+/// Logs carry it, so that a replay runs the filter with the same options.
+std::string ToYaml(const EskfOptions& options);
 
 /// Largest supported CloneOptions::max_clones (fixed-size storage).
 inline constexpr int kMaxClones = 8;

@@ -32,6 +32,12 @@ constexpr std::array kAllSchemas = {
     SchemaOf<diagnostic_msgs::DiagnosticArray>(),
     SchemaOf<rover_msgs::LogChannelHealth>(),
     SchemaOf<rover_msgs::LogHealth>(),
+    SchemaOf<rover_msgs::EstimatorImu>(),
+    SchemaOf<rover_msgs::EstimatorEvent>(),
+    SchemaOf<rover_msgs::EstimatorRelativePose>(),
+    SchemaOf<rover_msgs::EstimatorWheelSpeeds>(),
+    SchemaOf<rover_msgs::EstimatorState>(),
+    SchemaOf<rover_msgs::EstimatorFrameSwitch>(),
 };
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "core/log/msgs/builtin_interfaces.h"
 #include "core/log/msgs/diagnostic_msgs.h"
+#include "core/log/msgs/estimator_msgs.h"
 #include "core/log/msgs/geometry_msgs.h"
 #include "core/log/msgs/inline_string.h"
 #include "core/log/msgs/message_traits.h"

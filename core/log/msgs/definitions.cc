@@ -106,6 +106,53 @@ constexpr std::array kOwnTexts = {
             "uint64 records_written\n"
             "uint64 bytes_written\n"
             "LogChannelHealth[] channels"},
+    OwnText{"rover_msgs/EstimatorImu",
+            "uint64 sequence\n"
+            "int64 stamp_ns\n"
+            "float64[3] angular_velocity_rad_s\n"
+            "float64[3] linear_acceleration_m_s2"},
+    OwnText{"rover_msgs/EstimatorEvent",
+            "uint8 CLONE_TRIGGER=0\n"
+            "uint8 FRAME_SWITCH_REQUEST=1\n"
+            "uint8 POSE_REPORT_REQUEST=2\n"
+            "uint64 sequence\n"
+            "int64 stamp_ns\n"
+            "uint8 kind\n"
+            "uint64 request_id"},
+    OwnText{"rover_msgs/EstimatorRelativePose",
+            "uint64 sequence\n"
+            "int64 stamp_ns\n"
+            "int64 from_stamp_ns\n"
+            "int64 to_stamp_ns\n"
+            "float64[3] p_from_to_m\n"
+            "float64[4] q_from_to_xyzw\n"
+            "float64[36] covariance\n"
+            "bool to_is_keyframe\n"
+            "int64 oldest_keyframe_stamp_ns"},
+    OwnText{"rover_msgs/EstimatorWheelSpeeds",
+            "uint64 sequence\n"
+            "int64 stamp_ns\n"
+            "float64[4] wheel_rate_rad_s"},
+    OwnText{"rover_msgs/EstimatorState",
+            "uint64 sequence\n"
+            "int64 stamp_ns\n"
+            "uint32 frame_id\n"
+            "uint32 status\n"
+            "float64[3] p_local_body_m\n"
+            "float64[3] v_local_m_s\n"
+            "float64[4] q_local_body_xyzw\n"
+            "float64[3] accel_bias_m_s2\n"
+            "float64[3] gyro_bias_rad_s\n"
+            "float64[3] angular_velocity_body_rad_s\n"
+            "float64[225] covariance"},
+    OwnText{"rover_msgs/EstimatorFrameSwitch",
+            "uint64 sequence\n"
+            "int64 stamp_ns\n"
+            "uint32 old_frame_id\n"
+            "uint32 new_frame_id\n"
+            "float64[3] p_old_new_m\n"
+            "float64 yaw_old_new_rad\n"
+            "float64[16] covariance"},
 };
 
 // The primitive types of the ROS 2 interface definition language.

@@ -135,6 +135,56 @@ class RandomMessages {
     m->bytes_written = rng_();
     FillVector(&m->channels);
   }
+  void Fill(rover_msgs::EstimatorImu* m) {
+    m->sequence = rng_();
+    m->stamp_ns = static_cast<int64_t>(rng_());
+    FillArray(&m->angular_velocity_rad_s);
+    FillArray(&m->linear_acceleration_m_s2);
+  }
+  void Fill(rover_msgs::EstimatorEvent* m) {
+    m->sequence = rng_();
+    m->stamp_ns = static_cast<int64_t>(rng_());
+    m->kind = static_cast<uint8_t>(Uniform(0, 2));
+    m->request_id = rng_();
+  }
+  void Fill(rover_msgs::EstimatorRelativePose* m) {
+    m->sequence = rng_();
+    m->stamp_ns = static_cast<int64_t>(rng_());
+    m->from_stamp_ns = static_cast<int64_t>(rng_());
+    m->to_stamp_ns = static_cast<int64_t>(rng_());
+    FillArray(&m->p_from_to_m);
+    FillArray(&m->q_from_to_xyzw);
+    FillArray(&m->covariance);
+    m->to_is_keyframe = Uniform(0, 1) == 1;
+    m->oldest_keyframe_stamp_ns = static_cast<int64_t>(rng_());
+  }
+  void Fill(rover_msgs::EstimatorWheelSpeeds* m) {
+    m->sequence = rng_();
+    m->stamp_ns = static_cast<int64_t>(rng_());
+    FillArray(&m->wheel_rate_rad_s);
+  }
+  void Fill(rover_msgs::EstimatorState* m) {
+    m->sequence = rng_();
+    m->stamp_ns = static_cast<int64_t>(rng_());
+    m->frame_id = static_cast<uint32_t>(rng_());
+    m->status = static_cast<uint32_t>(rng_());
+    FillArray(&m->p_local_body_m);
+    FillArray(&m->v_local_m_s);
+    FillArray(&m->q_local_body_xyzw);
+    FillArray(&m->accel_bias_m_s2);
+    FillArray(&m->gyro_bias_rad_s);
+    FillArray(&m->angular_velocity_body_rad_s);
+    FillArray(&m->covariance);
+  }
+  void Fill(rover_msgs::EstimatorFrameSwitch* m) {
+    m->sequence = rng_();
+    m->stamp_ns = static_cast<int64_t>(rng_());
+    m->old_frame_id = static_cast<uint32_t>(rng_());
+    m->new_frame_id = static_cast<uint32_t>(rng_());
+    FillArray(&m->p_old_new_m);
+    m->yaw_old_new_rad = Real();
+    FillArray(&m->covariance);
+  }
 
  private:
   int64_t Uniform(int64_t lo, int64_t hi) {
@@ -189,7 +239,9 @@ using AllMessageTypes = ::testing::Types<
     geometry_msgs::TwistWithCovariance, geometry_msgs::Transform, geometry_msgs::TransformStamped,
     sensor_msgs::Imu, sensor_msgs::Image, nav_msgs::Odometry, tf2_msgs::TFMessage,
     diagnostic_msgs::KeyValue, diagnostic_msgs::DiagnosticStatus, diagnostic_msgs::DiagnosticArray,
-    rover_msgs::LogChannelHealth, rover_msgs::LogHealth>;
+    rover_msgs::LogChannelHealth, rover_msgs::LogHealth, rover_msgs::EstimatorImu,
+    rover_msgs::EstimatorEvent, rover_msgs::EstimatorRelativePose, rover_msgs::EstimatorWheelSpeeds,
+    rover_msgs::EstimatorState, rover_msgs::EstimatorFrameSwitch>;
 
 /// gtest names for AllMessageTypes instances: the ROS type name.
 struct MessageTypeName {
