@@ -117,6 +117,10 @@ class LogChannel final : public LogChannelBase {
     return n;
   }
 
+  /// Records queued and not yet written (any thread; exact for the producer).
+  std::size_t queued() const { return static_cast<std::size_t>(ring_.size()); }
+  static constexpr std::size_t capacity() { return kSlots; }
+
   LogChannelCounters counters() const override {
     LogChannelCounters c;
     c.logged = logged_.load(std::memory_order_relaxed);
