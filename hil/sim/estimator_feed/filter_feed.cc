@@ -6,8 +6,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "drivers/can/canopen_wheel_protocol.h"
+#include "drivers/can/wheel_speed_decoder.h"
 #include "hil/sim/dataset/dataset_generator.h"
-#include "hil/sim/sensors/canopen_wheel_protocol.h"
 #include "hil/sim/sensors/gpio_edge_model.h"
 #include "hil/sim/sensors/imu_model.h"
 #include "hil/sim/world/world.h"
@@ -62,31 +63,11 @@ void FilterFeedOptions::Validate() const {
 std::vector<estimator::WheelSpeedMeasurement> DecodeWheelSpeeds(
     const std::vector<drivers::CanFrame>& frames) {
   std::vector<estimator::WheelSpeedMeasurement> out;
-  estimator::WheelSpeedMeasurement current;
-  std::array<bool, kWheelNodeCount> seen{};
-  bool open = false;
-  const auto flush = [&] {
-    if (open && std::all_of(seen.begin(), seen.end(), [](bool b) { return b; })) {
-      out.push_back(current);
-    }
-  };
+  drivers::WheelSpeedDecoder decoder;
   for (const drivers::CanFrame& f : frames) {
-    if (IsSync(f)) {
-      flush();
-      current = {};
-      current.stamp = f.stamp;
-      seen = {};
-      open = true;
-      continue;
-    }
-    if (!open) continue;
-    if (const auto tpdo = DecodeWheelTpdo1(f)) {
-      const auto i = static_cast<std::size_t>(tpdo->node_id - 1);
-      current.wheel_rate_rad_s[i] = tpdo->velocity_mrad_s * kTpdoVelocityUnit_rad_s;
-      seen[i] = true;
-    }
+    if (const auto speeds = decoder.Feed(f))
+      out.push_back({speeds->stamp, speeds->wheel_rate_rad_s});
   }
-  flush();
   return out;
 }
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "drivers/can/canopen_wheel_protocol.h"
 #include "hil/sim/seed.h"
-#include "hil/sim/sensors/canopen_wheel_protocol.h"
 
 namespace rover::sim {
 namespace {
@@ -140,7 +140,7 @@ void WheelOdometryModel::GenerateSync(uint64_t k, std::vector<WheelSyncState>* s
   const Time sync = SyncTime(k);
   IntegrateTo((sync - start_).ToSeconds());
   std::vector<drivers::CanFrame> batch;
-  batch.push_back(EncodeSync(sync));
+  batch.push_back(drivers::EncodeSync(sync));
 
   WheelSyncState state;
   state.stamp = sync;
@@ -162,15 +162,15 @@ void WheelOdometryModel::GenerateSync(uint64_t k, std::vector<WheelSyncState>* s
       delay_s +=
           std::clamp(options_.tpdo_jitter_sigma_s * timing_normal_(timing_rng_), -limit, limit);
     }
-    WheelTpdo1 tpdo;
+    drivers::WheelTpdo1 tpdo;
     tpdo.node_id = static_cast<uint8_t>(w + 1);
     double velocity = rates_.omega_rad_s[i];
     if (options_.velocity_noise_sigma_rad_s > 0.0) {
       velocity += options_.velocity_noise_sigma_rad_s * velocity_normal_(velocity_rng_);
     }
-    tpdo.velocity_mrad_s = VelocityToTpdo(velocity);
-    tpdo.position_ticks = WrapTicks(state.encoder_ticks[i]);
-    batch.push_back(EncodeWheelTpdo1(sync + Duration::FromSeconds(delay_s), tpdo));
+    tpdo.velocity_mrad_s = drivers::VelocityToTpdo(velocity);
+    tpdo.position_ticks = drivers::WrapTicks(state.encoder_ticks[i]);
+    batch.push_back(drivers::EncodeWheelTpdo1(sync + Duration::FromSeconds(delay_s), tpdo));
 
     // Heartbeats due in this SYNC period.
     const Time period_end = sync + kSyncPeriod;
@@ -179,7 +179,7 @@ void WheelOdometryModel::GenerateSync(uint64_t k, std::vector<WheelSyncState>* s
                         Duration::Seconds(1) * static_cast<int64_t>(next_heartbeat_[i]);
       if (beat >= period_end) break;
       if (beat >= sync) {
-        batch.push_back(EncodeHeartbeat(beat, {tpdo.node_id, kNmtOperational}));
+        batch.push_back(drivers::EncodeHeartbeat(beat, {tpdo.node_id, drivers::kNmtOperational}));
       }
       ++next_heartbeat_[i];
     }

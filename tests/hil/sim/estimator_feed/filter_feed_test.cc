@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/geometry/so3.h"
-#include "hil/sim/sensors/canopen_wheel_protocol.h"
+#include "drivers/can/canopen_wheel_protocol.h"
 #include "hil/sim/sensors/gpio_edge_model.h"
 #include "hil/sim/sensors/imu_model.h"
 
@@ -254,15 +254,16 @@ TEST(FilterFeedTest, WheelSpeedsDecodedFromCanMatchTheModel) {
 TEST(FilterFeedTest, DecoderNeedsAllFourDrivesAndIgnoresHeartbeats) {
   const Time t = Time::FromSeconds(10.0);
   std::vector<drivers::CanFrame> frames;
-  frames.push_back(EncodeSync(t));
+  frames.push_back(drivers::EncodeSync(t));
   for (uint8_t node = 1; node <= 4; ++node) {
-    frames.push_back(
-        EncodeWheelTpdo1(t + Duration::Microseconds(200 * node), {node, 1000 * node - 2500, 7}));
+    frames.push_back(drivers::EncodeWheelTpdo1(t + Duration::Microseconds(200 * node),
+                                               {node, 1000 * node - 2500, 7}));
   }
-  frames.push_back(EncodeHeartbeat(t + Duration::Milliseconds(2), {2, kNmtOperational}));
+  frames.push_back(
+      drivers::EncodeHeartbeat(t + Duration::Milliseconds(2), {2, drivers::kNmtOperational}));
   const Time t2 = t + Duration::Milliseconds(10);
-  frames.push_back(EncodeSync(t2));
-  frames.push_back(EncodeWheelTpdo1(t2 + Duration::Microseconds(200), {1, 5, 0}));
+  frames.push_back(drivers::EncodeSync(t2));
+  frames.push_back(drivers::EncodeWheelTpdo1(t2 + Duration::Microseconds(200), {1, 5, 0}));
   const auto out = DecodeWheelSpeeds(frames);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].stamp, t);

@@ -1,9 +1,9 @@
 #include <gtest/gtest.h>
 
+#include "drivers/can/canopen_wheel_protocol.h"
 #include "hil/sim/live/sim_can_bus.h"
 #include "hil/sim/live/sim_imu_driver.h"
 #include "hil/sim/live/sim_stereo_camera_driver.h"
-#include "hil/sim/sensors/canopen_wheel_protocol.h"
 
 namespace rover::sim {
 namespace {
@@ -78,13 +78,13 @@ TEST(SimWheelCanBusTest, DeliversSyncAndFourTpdosEveryTenMilliseconds) {
   while (bus.Receive(&frame, Duration::Zero()) == drivers::ReadStatus::kOk) {
     ASSERT_GE(frame.stamp, last);
     last = frame.stamp;
-    if (IsSync(frame)) ++syncs;
-    if (const auto tpdo = DecodeWheelTpdo1(frame)) {
+    if (drivers::IsSync(frame)) ++syncs;
+    if (const auto tpdo = drivers::DecodeWheelTpdo1(frame)) {
       EXPECT_GE(tpdo->node_id, 1);
       EXPECT_LE(tpdo->node_id, 4);
       ++tpdos;
     }
-    if (DecodeHeartbeat(frame).has_value()) ++heartbeats;
+    if (drivers::DecodeHeartbeat(frame).has_value()) ++heartbeats;
   }
   EXPECT_EQ(syncs, 100);
   EXPECT_NEAR(tpdos, 400, 4);  // the last SYNC's TPDOs may fall past the end

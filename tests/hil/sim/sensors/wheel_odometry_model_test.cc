@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "hil/sim/sensors/canopen_wheel_protocol.h"
+#include "drivers/can/canopen_wheel_protocol.h"
 #include "tests/hil/sim/motion/test_terrain.h"
 
 namespace rover::sim {
@@ -78,13 +78,13 @@ TEST(WheelOdometryModelTest, FrameIdsAndTiming) {
     if (i > 0) {
       ASSERT_GE(f.stamp, frames[i - 1].stamp);
     }
-    if (IsSync(f)) {
+    if (drivers::IsSync(f)) {
       syncs.push_back(f.stamp);
       // The next four wheel frames are TPDO1 of nodes 1..4, in order.
       int node = 1;
       for (std::size_t j = i + 1; j < frames.size() && node <= 4; ++j) {
-        if (DecodeHeartbeat(frames[j])) continue;
-        const auto tpdo = DecodeWheelTpdo1(frames[j]);
+        if (drivers::DecodeHeartbeat(frames[j])) continue;
+        const auto tpdo = drivers::DecodeWheelTpdo1(frames[j]);
         ASSERT_TRUE(tpdo.has_value()) << "frame " << j;
         EXPECT_EQ(tpdo->node_id, node);
         const double delay_us = (frames[j].stamp - f.stamp).ToMicroseconds();
@@ -93,13 +93,13 @@ TEST(WheelOdometryModelTest, FrameIdsAndTiming) {
         ++node;
       }
       EXPECT_EQ(node, 5);
-    } else if (const auto beat = DecodeHeartbeat(f)) {
+    } else if (const auto beat = drivers::DecodeHeartbeat(f)) {
       ASSERT_GE(beat->node_id, 1);
       ASSERT_LE(beat->node_id, 4);
-      EXPECT_EQ(beat->nmt_state, kNmtOperational);
+      EXPECT_EQ(beat->nmt_state, drivers::kNmtOperational);
       beats[beat->node_id - 1u].push_back(f.stamp);
     } else {
-      ASSERT_TRUE(DecodeWheelTpdo1(f).has_value());
+      ASSERT_TRUE(drivers::DecodeWheelTpdo1(f).has_value());
     }
   }
   ASSERT_EQ(syncs.size(), 300u);
@@ -144,7 +144,7 @@ TEST(WheelOdometryModelTest, TicksMatchWheelRotationWithoutSlip) {
   std::array<int32_t, 4> last_position{};
   int32_t max_velocity = 0;
   for (const drivers::CanFrame& f : frames) {
-    if (const auto tpdo = DecodeWheelTpdo1(f)) {
+    if (const auto tpdo = drivers::DecodeWheelTpdo1(f)) {
       last_position[tpdo->node_id - 1u] = tpdo->position_ticks;
       max_velocity = std::max(max_velocity, tpdo->velocity_mrad_s);
     }

@@ -1,9 +1,9 @@
-#ifndef ROVER_HIL_SIM_SENSORS_CANOPEN_WHEEL_PROTOCOL_H_
-#define ROVER_HIL_SIM_SENSORS_CANOPEN_WHEEL_PROTOCOL_H_
+#ifndef ROVER_DRIVERS_CAN_CANOPEN_WHEEL_PROTOCOL_H_
+#define ROVER_DRIVERS_CAN_CANOPEN_WHEEL_PROTOCOL_H_
 
 // The motor-controller CAN protocol of the wheel drives (DESIGN.md), as pure
-// encode/decode functions with no simulator dependency, so that the SocketCAN
-// driver can reuse them unchanged (they are meant to move to drivers/can/).
+// encode/decode functions, shared by the SocketCAN driver, roverd's wheel
+// decoder and the simulator's drives.
 //
 // CANopen CiA 402 style, classic 11-bit frames:
 //   SYNC       id 0x080, no payload, from the bus master at 100 Hz.
@@ -21,7 +21,7 @@
 #include "core/time/time.h"
 #include "drivers/can/can_frame.h"
 
-namespace rover::sim {
+namespace rover::drivers {
 
 inline constexpr uint32_t kCanSyncId = 0x080;
 inline constexpr uint32_t kCanTpdo1BaseId = 0x180;
@@ -47,18 +47,18 @@ struct CanHeartbeat {
 };
 
 /// The SYNC frame (no payload).
-drivers::CanFrame EncodeSync(Time stamp);
+CanFrame EncodeSync(Time stamp);
 /// TPDO1 of drive `tpdo.node_id` (1..4).
-drivers::CanFrame EncodeWheelTpdo1(Time stamp, const WheelTpdo1& tpdo);
+CanFrame EncodeWheelTpdo1(Time stamp, const WheelTpdo1& tpdo);
 /// Heartbeat of `heartbeat.node_id` (1..127).
-drivers::CanFrame EncodeHeartbeat(Time stamp, const CanHeartbeat& heartbeat);
+CanFrame EncodeHeartbeat(Time stamp, const CanHeartbeat& heartbeat);
 
 /// True for a SYNC frame (id 0x080; any DLC 0..1, a SYNC counter is allowed).
-bool IsSync(const drivers::CanFrame& frame);
+bool IsSync(const CanFrame& frame);
 /// The TPDO1 of a wheel drive (id 0x181..0x184 with DLC 8), else nullopt.
-std::optional<WheelTpdo1> DecodeWheelTpdo1(const drivers::CanFrame& frame);
+std::optional<WheelTpdo1> DecodeWheelTpdo1(const CanFrame& frame);
 /// A heartbeat (id 0x701..0x77F with DLC 1), else nullopt.
-std::optional<CanHeartbeat> DecodeHeartbeat(const drivers::CanFrame& frame);
+std::optional<CanHeartbeat> DecodeHeartbeat(const CanFrame& frame);
 
 /// Rounds a wheel rate to the TPDO unit, saturating at the int32 range.
 int32_t VelocityToTpdo(double angular_velocity_rad_s);
@@ -66,6 +66,6 @@ int32_t VelocityToTpdo(double angular_velocity_rad_s);
 /// holds it (two's complement wrap-around).
 int32_t WrapTicks(int64_t ticks);
 
-}  // namespace rover::sim
+}  // namespace rover::drivers
 
-#endif  // ROVER_HIL_SIM_SENSORS_CANOPEN_WHEEL_PROTOCOL_H_
+#endif  // ROVER_DRIVERS_CAN_CANOPEN_WHEEL_PROTOCOL_H_

@@ -1,4 +1,4 @@
-#include "hil/sim/sensors/canopen_wheel_protocol.h"
+#include "drivers/can/canopen_wheel_protocol.h"
 
 #include <gtest/gtest.h>
 
@@ -6,14 +6,13 @@
 #include <cstdint>
 #include <limits>
 
-namespace rover::sim {
+namespace rover::drivers {
 namespace {
 
 const Time kStamp = Time::FromNanoseconds(123'456'789);
 
 TEST(CanopenWheelProtocolTest, Tpdo1LayoutIsLittleEndianVelocityThenPosition) {
-  const drivers::CanFrame f =
-      EncodeWheelTpdo1(kStamp, {3, 0x01020304, static_cast<int32_t>(0xF1F2F3F4u)});
+  const CanFrame f = EncodeWheelTpdo1(kStamp, {3, 0x01020304, static_cast<int32_t>(0xF1F2F3F4u)});
   EXPECT_EQ(f.stamp, kStamp);
   EXPECT_EQ(f.id, 0x183u);
   EXPECT_EQ(f.dlc, 8);
@@ -36,7 +35,7 @@ TEST(CanopenWheelProtocolTest, Tpdo1RoundTrip) {
 }
 
 TEST(CanopenWheelProtocolTest, DecodersRejectOtherFrames) {
-  drivers::CanFrame f = EncodeWheelTpdo1(kStamp, {1, 5, 6});
+  CanFrame f = EncodeWheelTpdo1(kStamp, {1, 5, 6});
   f.dlc = 7;
   EXPECT_FALSE(DecodeWheelTpdo1(f).has_value());
   f = EncodeWheelTpdo1(kStamp, {1, 5, 6});
@@ -50,11 +49,11 @@ TEST(CanopenWheelProtocolTest, DecodersRejectOtherFrames) {
 }
 
 TEST(CanopenWheelProtocolTest, SyncAndHeartbeat) {
-  const drivers::CanFrame sync = EncodeSync(kStamp);
+  const CanFrame sync = EncodeSync(kStamp);
   EXPECT_EQ(sync.id, 0x080u);
   EXPECT_EQ(sync.dlc, 0);
   EXPECT_TRUE(IsSync(sync));
-  const drivers::CanFrame beat = EncodeHeartbeat(kStamp, {4, kNmtOperational});
+  const CanFrame beat = EncodeHeartbeat(kStamp, {4, kNmtOperational});
   EXPECT_EQ(beat.id, 0x704u);
   EXPECT_EQ(beat.dlc, 1);
   EXPECT_EQ(beat.data[0], 0x05);
@@ -82,4 +81,4 @@ TEST(CanopenWheelProtocolTest, VelocityUnitsAndTickWrap) {
 }
 
 }  // namespace
-}  // namespace rover::sim
+}  // namespace rover::drivers

@@ -1,9 +1,9 @@
-#include "hil/sim/sensors/canopen_wheel_protocol.h"
+#include "drivers/can/canopen_wheel_protocol.h"
 
 #include <cmath>
 #include <limits>
 
-namespace rover::sim {
+namespace rover::drivers {
 namespace {
 
 void PutInt32(int32_t value, uint8_t* out) {
@@ -19,16 +19,16 @@ int32_t GetInt32(const uint8_t* in) {
 
 }  // namespace
 
-drivers::CanFrame EncodeSync(Time stamp) {
-  drivers::CanFrame f;
+CanFrame EncodeSync(Time stamp) {
+  CanFrame f;
   f.stamp = stamp;
   f.id = kCanSyncId;
   f.dlc = 0;
   return f;
 }
 
-drivers::CanFrame EncodeWheelTpdo1(Time stamp, const WheelTpdo1& tpdo) {
-  drivers::CanFrame f;
+CanFrame EncodeWheelTpdo1(Time stamp, const WheelTpdo1& tpdo) {
+  CanFrame f;
   f.stamp = stamp;
   f.id = kCanTpdo1BaseId + tpdo.node_id;
   f.dlc = 8;
@@ -37,8 +37,8 @@ drivers::CanFrame EncodeWheelTpdo1(Time stamp, const WheelTpdo1& tpdo) {
   return f;
 }
 
-drivers::CanFrame EncodeHeartbeat(Time stamp, const CanHeartbeat& heartbeat) {
-  drivers::CanFrame f;
+CanFrame EncodeHeartbeat(Time stamp, const CanHeartbeat& heartbeat) {
+  CanFrame f;
   f.stamp = stamp;
   f.id = kCanHeartbeatBaseId + heartbeat.node_id;
   f.dlc = 1;
@@ -46,9 +46,9 @@ drivers::CanFrame EncodeHeartbeat(Time stamp, const CanHeartbeat& heartbeat) {
   return f;
 }
 
-bool IsSync(const drivers::CanFrame& frame) { return frame.id == kCanSyncId && frame.dlc <= 1; }
+bool IsSync(const CanFrame& frame) { return frame.id == kCanSyncId && frame.dlc <= 1; }
 
-std::optional<WheelTpdo1> DecodeWheelTpdo1(const drivers::CanFrame& frame) {
+std::optional<WheelTpdo1> DecodeWheelTpdo1(const CanFrame& frame) {
   if (frame.id <= kCanTpdo1BaseId || frame.id > kCanTpdo1BaseId + kWheelNodeCount ||
       frame.dlc != 8) {
     return std::nullopt;
@@ -60,7 +60,7 @@ std::optional<WheelTpdo1> DecodeWheelTpdo1(const drivers::CanFrame& frame) {
   return out;
 }
 
-std::optional<CanHeartbeat> DecodeHeartbeat(const drivers::CanFrame& frame) {
+std::optional<CanHeartbeat> DecodeHeartbeat(const CanFrame& frame) {
   if (frame.id <= kCanHeartbeatBaseId || frame.id > kCanHeartbeatBaseId + 0x7F || frame.dlc != 1) {
     return std::nullopt;
   }
@@ -80,4 +80,4 @@ int32_t WrapTicks(int64_t ticks) {
   return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>(ticks)));
 }
 
-}  // namespace rover::sim
+}  // namespace rover::drivers
