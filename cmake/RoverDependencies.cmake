@@ -16,6 +16,11 @@ if(NOT ROVER_FUZZ)
   pkg_check_modules(APRILTAG REQUIRED IMPORTED_TARGET apriltag)
   find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
   find_package(Ceres 2.1 REQUIRED)
+  # Log service (firmware/runtime/log_service) and rover-log list/download:
+  # cpp-httplib is a compiled library on Debian (its pkg-config flags select
+  # the OpenSSL/zlib/brotli build it was compiled with); SHA-256 via libcrypto.
+  pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
+  find_package(OpenSSL REQUIRED COMPONENTS Crypto)
   if(ROVER_BUILD_TESTS)
     find_package(GTest REQUIRED)
     include(GoogleTest)

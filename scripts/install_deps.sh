@@ -38,6 +38,10 @@ DEBIAN_PACKAGES=(
   libegl-mesa0               # Mesa's EGL driver (surfaceless platform, no display needed)
   libgl1-mesa-dri            # Mesa's llvmpipe software rasteriser: renders without a GPU
   libceres-dev               # pose-graph back end (mapping/graph, rover-graph): Manifold API, sparse Cholesky
+  rt-tests                   # cyclictest: reference wake-up latency for scripts/rt_latency.sh
+  libsystemd-dev             # sd_notify: roverd's systemd watchdog and readiness notification
+  libcpp-httplib-dev         # HTTP log service on the board and `rover-log list/download` (cpp-httplib 0.11)
+  libssl-dev                 # SHA-256 of served logs (OpenSSL libcrypto EVP), also needed by cpp-httplib
 )
 
 SUDO=""

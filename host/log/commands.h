@@ -6,6 +6,7 @@
 //   0 success, 1 the file is damaged (verify) or partly unreadable,
 //   2 bad usage or unreadable input.
 
+#include <functional>
 #include <ostream>
 #include <string>
 
@@ -37,6 +38,62 @@ int RunVerify(const std::string& path, std::ostream& out, std::ostream& err);
 /// file OUT and reports what could not be saved.
 int RunRecover(const std::string& in, const std::string& out_path,
                const log::McapWriterOptions& options, std::ostream& out, std::ostream& err);
+
+/// How `list` and `download` reach the board's log service.
+struct LogServiceAccess {
+  std::string url;         ///< "http://HOST:PORT".
+  std::string token;       ///< --token (visible in `ps`; prefer a token file).
+  std::string token_file;  ///< --token-file; else ROVER_LOG_TOKEN is used.
+  int connect_timeout_s = 5;
+  int read_timeout_s = 30;
+};
+
+struct ListOptions {
+  LogServiceAccess access;
+  bool json = false;  ///< Print the service's JSON listing as received.
+};
+
+/// `rover-log list --url URL --token-file FILE [--json]`: one row per log on
+/// the board: name, size, duration and first log time, complete or
+/// in-progress, SHA-256 prefix. Exit 0 ok, 1 network or service failure,
+/// 2 bad URL, missing or refused token.
+int RunList(const ListOptions& options, std::ostream& out, std::ostream& err);
+
+/// Test hooks of RunDownload; empty in the tool.
+struct DownloadHooks {
+  /// After the listing was fetched, before any byte is requested.
+  std::function<void()> after_listing;
+  /// When NAME.part holds every listed byte, before its SHA-256 is checked.
+  std::function<void(const std::string& part_path)> before_verify;
+};
+
+struct DownloadOptions {
+  LogServiceAccess access;
+  std::string name;           ///< Log name as listed (a plain file name).
+  std::string out_dir = ".";  ///< Created if missing.
+  /// Attempts in a row that may fail without receiving a byte before giving
+  /// up; an attempt that makes progress resets the count.
+  int retries = 5;
+  double initial_backoff_s = 0.5;  ///< Wait before the first retry; doubles per retry.
+  double max_backoff_s = 10.0;     ///< Longest wait between attempts (also caps Retry-After).
+  /// Redraw one progress line in place (stderr is a terminal); otherwise a
+  /// line at every 10 %.
+  bool progress_tty = false;
+  DownloadHooks hooks;
+};
+
+/// `rover-log download NAME --url URL --token-file FILE [--out DIR]`: fetches
+/// the listed bytes of NAME into DIR/NAME.part (resuming from its size with a
+/// Range request, also after a cut connection), shows progress with rate and
+/// ETA on `err`, checks the SHA-256 against the listing and only then renames
+/// the file to DIR/NAME (atomically, replacing an older DIR/NAME only then).
+/// On a mismatch the .part file is deleted and nothing is left under NAME.
+/// The listed size is what is fetched: a log still being written comes down
+/// up to its last complete record at listing time. Exit 0 ok, 1 network
+/// failure after the retries, hash mismatch or service error, 2 bad input
+/// (name, URL, token, folder, a name the service does not list, a refused
+/// token).
+int RunDownload(const DownloadOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace rover::host
 

@@ -1,4 +1,7 @@
-// rover-log: inspect, export, verify and repair rover flight logs (MCAP).
+// rover-log: list and download logs from the board, inspect, export, verify and repair rover
+// flight logs (MCAP).
+
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -9,7 +12,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "rover-log: inspect, export, verify and repair rover flight logs.\n"
+      "rover-log: list and download, inspect, export, verify and repair rover flight logs.\n"
       "Flight logs are MCAP files with ROS 2 CDR messages (they open in Foxglove Studio and play\n"
       "with `ros2 bag`). A log cut short by power loss stays readable up to its last complete\n"
       "chunk; `verify` says what is damaged and where, `recover` saves the rest."};
@@ -49,11 +52,87 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 19))
       ->capture_default_str();
 
-  CLI11_PARSE(app, argc, argv);
+  // The board's log service: list and download.
+  const auto add_access_options = [](CLI::App* command, rover::host::LogServiceAccess& access) {
+    command->add_option("--url", access.url, "the board's log service, http://HOST:PORT")
+        ->required();
+    command->add_option("--token-file", access.token_file,
+                        "file holding the service's bearer token (the default source; else "
+                        "--token, else the environment variable ROVER_LOG_TOKEN)");
+    command->add_option("--token", access.token,
+                        "the bearer token itself (visible to other users in `ps`; prefer "
+                        "--token-file or ROVER_LOG_TOKEN)");
+    command
+        ->add_option("--connect-timeout-s", access.connect_timeout_s,
+                     "give up connecting after this long")
+        ->check(CLI::Range(1, 600))
+        ->capture_default_str();
+    command
+        ->add_option("--read-timeout-s", access.read_timeout_s,
+                     "give up on a connection silent for this long")
+        ->check(CLI::Range(1, 3600))
+        ->capture_default_str();
+  };
+
+  rover::host::ListOptions list_options;
+  auto* list = app.add_subcommand(
+      "list",
+      "List the logs on the board: name, size, duration and first log time, complete or\n"
+      "in-progress, SHA-256 prefix. A log still being written is listed (and served) up to its\n"
+      "last complete record. Times are log times on the rover's monotonic clock, not wall clock.\n"
+      "Exit 0 ok, 1 network or service failure, 2 bad URL or missing/refused token.");
+  add_access_options(list, list_options.access);
+  list->add_flag("--json", list_options.json, "print the service's JSON listing as received");
+
+  rover::host::DownloadOptions download_options;
+  auto* download = app.add_subcommand(
+      "download",
+      "Download one log from the board into DIR/NAME.part, resuming with Range requests after a\n"
+      "cut connection (and from an existing NAME.part), with a progress bar (rate, ETA) on\n"
+      "stderr. The SHA-256 is checked against the listing before the file is renamed to\n"
+      "DIR/NAME; on a mismatch nothing is kept. Exit 0 ok, 1 network failure after the retries\n"
+      "or hash mismatch, 2 bad input (name, URL, token, folder, or a log the board does not "
+      "list).");
+  download->add_option("NAME", download_options.name, "log name as listed, e.g. flight_0001.mcap")
+      ->required();
+  add_access_options(download, download_options.access);
+  download
+      ->add_option("--out", download_options.out_dir, "folder to write into (created if missing)")
+      ->capture_default_str();
+  download
+      ->add_option("--retries", download_options.retries,
+                   "attempts in a row that may fail without receiving a byte before giving "
+                   "up (any progress resets the count)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  download
+      ->add_option("--backoff-s", download_options.initial_backoff_s,
+                   "wait before the first retry; doubles per failed retry, at most "
+                   "--max-backoff-s")
+      ->check(CLI::Range(0.0, 600.0))
+      ->capture_default_str();
+  download
+      ->add_option("--max-backoff-s", download_options.max_backoff_s,
+                   "longest wait between attempts (also caps the service's Retry-After)")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+
+  // Usage errors exit with 2, as the subcommands do for bad input.
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
 
   if (*info) return rover::host::RunInfo(path, std::cout, std::cerr);
   if (*exp) return rover::host::RunExport(export_options, std::cout, std::cerr);
   if (*verify) return rover::host::RunVerify(path, std::cout, std::cerr);
+  if (*list) return rover::host::RunList(list_options, std::cout, std::cerr);
+  if (*download) {
+    download_options.progress_tty = ::isatty(STDERR_FILENO) == 1;
+    return rover::host::RunDownload(download_options, std::cout, std::cerr);
+  }
   if (*recover) {
     static const std::map<std::string, rover::log::Compression> kCodecs = {
         {"zstd", rover::log::Compression::kZstd},

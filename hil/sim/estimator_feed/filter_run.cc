@@ -155,8 +155,16 @@ class Scorer : public estimator::EskfOutputSink {
 }  // namespace
 
 estimator::EskfOptions EskfOptionsForFeed(const FilterFeed& feed) {
+  return EskfOptionsForScenario(feed.scenario(), feed.trajectory(), feed.wheel_options(),
+                                feed.options().wheels_enabled);
+}
+
+estimator::EskfOptions EskfOptionsForScenario(const Scenario& scenario,
+                                              const RoverTrajectory& trajectory,
+                                              const WheelOdometryOptions& wheel_options,
+                                              bool wheels_enabled) {
   estimator::EskfOptions o;
-  const ImuModelOptions& imu = feed.scenario().imu;
+  const ImuModelOptions& imu = scenario.imu;
   o.imu.rate_hz = imu.rate_hz;
   o.imu.gyro_noise_density_rad_s_sqrt_hz = imu.gyro.noise_density;
   o.imu.gyro_bias_random_walk_rad_s2_sqrt_hz = imu.gyro.bias_random_walk;
@@ -168,14 +176,14 @@ estimator::EskfOptions EskfOptionsForFeed(const FilterFeed& feed) {
   o.imu.accel_range_m_s2 = std::isfinite(imu.accel.range) ? imu.accel.range : kUnbounded;
   o.imu.gravity_m_s2 = kStandardGravity_m_s2;
 
-  const RoverTrajectoryOptions& rover = feed.trajectory().options();
-  o.wheels.enabled = feed.options().wheels_enabled;
+  const RoverTrajectoryOptions& rover = trajectory.options();
+  o.wheels.enabled = wheels_enabled;
   o.wheels.wheel_radius_m = rover.wheel_radius_m;
   o.wheels.track_m = rover.track_m;
-  o.wheels.yaw_scrub_factor = feed.wheel_options().yaw_scrub_factor;
+  o.wheels.yaw_scrub_factor = wheel_options.yaw_scrub_factor;
   // The wheel-axle centre: the mean of the four wheel centres.
   Eigen::Vector3d axle = Eigen::Vector3d::Zero();
-  for (int w = 0; w < kWheelCount; ++w) axle += feed.trajectory().WheelCenterBody(w);
+  for (int w = 0; w < kWheelCount; ++w) axle += trajectory.WheelCenterBody(w);
   o.wheels.lever_arm_body_m = axle / kWheelCount;
   // The simulated rover's planar path is that of the body origin (the IMU):
   // it is the point without sideways velocity (a real rover's is the wheel
@@ -183,8 +191,8 @@ estimator::EskfOptions EskfOptionsForFeed(const FilterFeed& feed) {
   o.wheels.nonholonomic_point_body_m = Eigen::Vector3d::Zero();
   // The wheel-terrain slip calibration: the simulator's mean slip against
   // tilt (its roughness term and slip noise stay unmodelled).
-  o.wheels.slip_ratio_base = feed.wheel_options().slip_base_ratio;
-  o.wheels.slip_ratio_per_tilt_rad = feed.wheel_options().slip_slope_gain_per_rad;
+  o.wheels.slip_ratio_base = wheel_options.slip_base_ratio;
+  o.wheels.slip_ratio_per_tilt_rad = wheel_options.slip_slope_gain_per_rad;
   return o;
 }
 

@@ -38,6 +38,11 @@ namespace rover::sim {
 /// centre relative to the IMU as lever arm; wheels enabled as in the feed.
 /// Everything else keeps the EskfOptions defaults.
 estimator::EskfOptions EskfOptionsForFeed(const FilterFeed& feed);
+/// The same for a scenario's rover without a feed (roverd on the simulator).
+estimator::EskfOptions EskfOptionsForScenario(const Scenario& scenario,
+                                              const RoverTrajectory& trajectory,
+                                              const WheelOdometryOptions& wheel_options,
+                                              bool wheels_enabled);
 
 struct FilterRunOptions {
   /// Excluded from the NEES averages after initialisation and each switch.

@@ -31,6 +31,9 @@ drivers::ReadStatus SimStereoCameraDriver::Next(drivers::StereoFrame* frame, Dur
   const double t_s = (trigger - start_).ToSeconds();
   MovingCarrierPoses(carriers_, self_, t_s, &T_world_carriers_);
   renderer_.Render(PoseOf(trajectory_.Evaluate(t_s)), T_world_carriers_, next_index_, &rendered_);
+  // The driver may be read from any thread, one at a time: leave the GL
+  // context free for the next caller (and for the renderer's destructor).
+  renderer_.ReleaseThread();
   frame->stamp = trigger;
   frame->sequence = next_index_++;
   frame->cam0 = ViewOf(rendered_.cam0);

@@ -131,4 +131,9 @@ void EglContext::MakeCurrent() {
   }
 }
 
+void EglContext::ReleaseCurrent() {
+  if (eglGetCurrentContext() != static_cast<EGLContext>(context_)) return;
+  eglMakeCurrent(static_cast<EGLDisplay>(display_), EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+}
+
 }  // namespace rover::sim

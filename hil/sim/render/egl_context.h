@@ -23,6 +23,9 @@ class EglContext {
 
   /// Binds the context to the calling thread (a no-op if already bound).
   void MakeCurrent();
+  /// Unbinds it from the calling thread if bound there, so that another
+  /// thread may bind it (EGL allows a context to be current in one thread).
+  void ReleaseCurrent();
 
   /// GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
   const std::string& renderer() const { return renderer_; }

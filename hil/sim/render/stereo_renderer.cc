@@ -1040,6 +1040,7 @@ const std::string& StereoRenderer::gl_renderer() const { return impl_->context.r
 const StereoCameraOptions& StereoRenderer::camera() const { return impl_->camera; }
 const RenderOptions& StereoRenderer::options() const { return impl_->options; }
 void StereoRenderer::set_apply_effects(bool apply) { impl_->options.apply_effects = apply; }
+void StereoRenderer::ReleaseThread() { impl_->context.ReleaseCurrent(); }
 int StereoRenderer::render_width_px() const { return impl_->render.width_px; }
 int StereoRenderer::render_height_px() const { return impl_->render.height_px; }
 int StereoRenderer::last_patch_count() const { return impl_->patch_count; }

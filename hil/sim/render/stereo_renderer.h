@@ -127,6 +127,10 @@ class StereoRenderer {
   const StereoCameraOptions& camera() const;
   const RenderOptions& options() const;
   void set_apply_effects(bool apply);
+  /// Unbinds the GL context from the calling thread, so that the next
+  /// Render() may run on another thread (the constructor leaves it bound to
+  /// the constructing thread, each Render() to the rendering one).
+  void ReleaseThread();
   /// Size of the undistorted pinhole image rasterised per camera.
   int render_width_px() const;
   int render_height_px() const;

@@ -1,0 +1,138 @@
+#ifndef ROVER_FIRMWARE_ROVERD_ROVERD_H_
+#define ROVER_FIRMWARE_ROVERD_ROVERD_H_
+
+// roverd's threads around the estimator loop (DESIGN.md):
+//   IMU thread (the caller of Run)  read IMU -> EstimatorLoop::Step
+//   camera thread                   frame -> clone trigger; images -> VO slot
+//   VO thread (low priority)        StereoOdometry -> relative pose
+//   CAN thread                      wheel drives' frames -> wheel speeds
+// The drivers are interfaces, so the same code runs on a board, on the HIL
+// bench and on the simulator's drivers. In lockstep mode (simulation faster
+// or slower than real time) the threads are coupled by a LockstepGate and no
+// input is dropped; in real time they run free and a busy VO drops frames
+// (counted), never the IMU loop.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/ring/spsc_ring.h"
+#include "drivers/camera/stereo_camera_driver.h"
+#include "drivers/can/can_bus.h"
+#include "drivers/can/wheel_speed_decoder.h"
+#include "drivers/imu/imu_driver.h"
+#include "estimator/vo/stereo_odometry.h"
+#include "firmware/roverd/estimator_loop.h"
+#include "firmware/roverd/lockstep_gate.h"
+#include "firmware/roverd/step_latency.h"
+
+namespace rover::roverd {
+
+/// The stereo head: calibration and VO options (absent: no VO).
+struct CameraSetup {
+  estimator::vo::CameraModel cam0;
+  estimator::vo::CameraModel cam1;
+  estimator::vo::StereoOdometryOptions vo;
+};
+
+struct RoverdOptions {
+  estimator::EskfOptions estimator;
+  std::optional<CameraSetup> camera;
+  bool lockstep = false;
+  /// Lockstep: a frame's VO result is delivered at capture + this (real time:
+  /// when the VO finishes).
+  Duration lockstep_vo_latency = Duration::Milliseconds(100);
+  /// Lockstep: how far the camera and CAN threads may run ahead of the IMU
+  /// (more than the CAN period, less than the rings hold).
+  Duration lockstep_lead = Duration::Milliseconds(300);
+  /// Image slots between the camera and the VO thread.
+  int frame_slots = 3;
+  /// Driver read timeouts; a silent sensor is noticed this often.
+  Duration read_timeout = Duration::Milliseconds(200);
+};
+
+/// The sensors. `camera` and `can` may be null (that sensor is absent).
+struct RoverdDrivers {
+  drivers::ImuDriver* imu = nullptr;
+  drivers::StereoCameraDriver* camera = nullptr;
+  drivers::CanBus* can = nullptr;
+};
+
+/// What a run did, for the summary and the health report.
+struct RoverdStats {
+  uint64_t imu_samples = 0;
+  uint64_t imu_drops = 0;  ///< samples missing from the IMU's sequence numbers
+  uint64_t imu_errors = 0;
+  uint64_t frames = 0;
+  uint64_t frame_drops = 0;  ///< frames the camera lost (sequence gaps) or the VO had no slot for
+  uint64_t vo_measurements = 0;
+  estimator::vo::VoHealth vo;
+  uint64_t wheel_readings = 0;
+  drivers::WheelSpeedDecoderStats can;
+  uint64_t can_errors = 0;
+  EstimatorLoopStats loop;
+  estimator::EskfHealth filter;
+  StepLatency::Percentiles step_latency;  ///< wall time of EstimatorLoop::Step
+};
+
+class Roverd {
+ public:
+  /// Sets everything up (threads start in Run()). Throws std::invalid_argument
+  /// when the camera calibration is unusable or the IMU driver is missing.
+  Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
+         const EstimatorLogChannels& channels, EstimatorListener* listener = nullptr);
+  ~Roverd();
+  Roverd(const Roverd&) = delete;
+  Roverd& operator=(const Roverd&) = delete;
+
+  /// Runs the IMU loop on the calling thread until the IMU stream ends or
+  /// Stop() is called, then stops the other threads and returns the totals.
+  RoverdStats Run();
+  /// Asks Run() to return (any thread, e.g. a signal handler's relay).
+  void Stop();
+
+  const EstimatorLoop& loop() const { return loop_; }
+
+ private:
+  struct FrameSlot {
+    Time capture;
+    cv::Mat cam0;
+    cv::Mat cam1;
+  };
+
+  void ImuLoop(RoverdStats* stats);
+  void CameraThread();
+  void VoThread();
+  void CanThread();
+  int AcquireSlot();
+
+  RoverdOptions options_;
+  RoverdDrivers drivers_;
+  EstimatorLoop loop_;
+  std::optional<estimator::vo::StereoOdometry> vo_;
+  LockstepGate gate_;
+  StepLatency step_latency_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int64_t> filter_init_ns_{0};  ///< IMU stamp when the filter started; 0: not yet
+
+  std::vector<FrameSlot> slots_;
+  SpscRing<int, 16> to_vo_;       // camera -> VO: filled slot indices
+  SpscRing<int, 16> free_slots_;  // VO -> camera: slots to reuse
+  std::atomic<uint64_t> frames_{0};
+  std::atomic<uint64_t> frame_drops_{0};
+  std::atomic<uint64_t> vo_measurements_{0};
+  std::atomic<uint64_t> wheel_readings_{0};
+  std::atomic<uint64_t> can_errors_{0};
+  drivers::WheelSpeedDecoder decoder_;  // CAN thread only; read after join
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace rover::roverd
+
+#endif  // ROVER_FIRMWARE_ROVERD_ROVERD_H_

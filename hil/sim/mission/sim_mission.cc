@@ -1,0 +1,273 @@
+#include "hil/sim/mission/sim_mission.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <ostream>
+#include <thread>
+
+#include "core/log/flight/flight_log.h"
+#include "drivers/replay/euroc_replay.h"
+#include "hil/sim/dataset/dataset_generator.h"
+#include "hil/sim/estimator_feed/filter_run.h"
+#include "hil/sim/live/sim_can_bus.h"
+#include "hil/sim/live/sim_imu_driver.h"
+#include "hil/sim/live/sim_stereo_camera_driver.h"
+#include "hil/sim/render/stereo_renderer.h"
+#include "hil/sim/scenario/scenario.h"
+#include "hil/sim/sensors/gpio_edge_model.h"
+#include "hil/sim/world/world.h"
+
+namespace rover::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+estimator::vo::CameraModel CameraModelOf(const StereoCameraOptions& cam,
+                                         const Eigen::Isometry3d& T_body_cam) {
+  estimator::vo::CameraModel m;
+  m.width_px = cam.width_px;
+  m.height_px = cam.height_px;
+  m.intrinsics = {cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px};
+  m.distortion = cam.DistortionCoeffs();
+  m.T_body_cam = T_body_cam;
+  return m;
+}
+
+// Latest filter output for the status line and the summary. Written on the
+// IMU thread (wait-free: a sequence counter around relaxed atomic fields),
+// read by the status thread.
+class LatestState final : public roverd::EstimatorListener {
+ public:
+  void OnState(const estimator::EskfOutput& o) override {
+    const uint64_t s = seq_.load(std::memory_order_relaxed);
+    seq_.store(s + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    stamp_ns_.store(o.stamp.nanoseconds(), std::memory_order_relaxed);
+    for (std::size_t i = 0; i < 3; ++i) {
+      p_[i].store(o.p_local_body[static_cast<int>(i)], std::memory_order_relaxed);
+    }
+    initialised_.store((o.status & estimator::kStatusNotInitialised) == 0,
+                       std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    seq_.store(s + 2, std::memory_order_release);
+    if ((o.status & estimator::kStatusNotInitialised) == 0 && !init_stamp_ns_) {
+      init_stamp_ns_ = o.stamp.nanoseconds();  // IMU thread only until the run ends
+    }
+  }
+  void OnFrameSwitch(const estimator::FrameSwitchRecord&) override {}
+
+  struct Snapshot {
+    Time stamp;
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    bool initialised = false;
+  };
+  Snapshot Read() const {
+    Snapshot out;
+    for (;;) {
+      const uint64_t s0 = seq_.load(std::memory_order_acquire);
+      if (s0 % 2 == 1) continue;
+      out.stamp = Time::FromNanoseconds(stamp_ns_.load(std::memory_order_relaxed));
+      for (std::size_t i = 0; i < 3; ++i) {
+        out.p[static_cast<int>(i)] = p_[i].load(std::memory_order_relaxed);
+      }
+      out.initialised = initialised_.load(std::memory_order_relaxed);
+      std::atomic_thread_fence(std::memory_order_acquire);
+      if (seq_.load(std::memory_order_relaxed) == s0) return out;
+    }
+  }
+  std::optional<int64_t> init_stamp_ns() const { return init_stamp_ns_; }
+
+ private:
+  std::atomic<uint64_t> seq_{0};
+  std::atomic<int64_t> stamp_ns_{0};
+  std::array<std::atomic<double>, 3> p_{};
+  std::atomic<bool> initialised_{false};
+  std::optional<int64_t> init_stamp_ns_;
+};
+
+// The true pose in the filter's frame 0: defined by the true position and
+// yaw at the filter's initialisation (as FilterRun scores it).
+Eigen::Vector3d TrueInFrame0(const RoverTrajectory& trajectory, Time start, Time init, Time t) {
+  const TrajectorySample s0 = trajectory.Evaluate((init - start).ToSeconds());
+  const TrajectorySample s = trajectory.Evaluate((t - start).ToSeconds());
+  const Eigen::Matrix3d R0 = s0.q_world_body.toRotationMatrix();
+  const double yaw0 = std::atan2(R0(1, 0), R0(0, 0));
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(yaw0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return Rz.transpose() * (s.p_world_body - s0.p_world_body);
+}
+
+double DistanceDriven(const RoverTrajectory& trajectory, double from_s, double to_s) {
+  double d = 0.0;
+  Eigen::Vector2d last = trajectory.Evaluate(from_s).p_world_body.head<2>();
+  for (double t = from_s + 0.05; t <= to_s; t += 0.05) {
+    const Eigen::Vector2d p = trajectory.Evaluate(t).p_world_body.head<2>();
+    d += (p - last).norm();
+    last = p;
+  }
+  return d;
+}
+
+std::string Fixed(double v, int digits) {
+  char text[48];
+  std::snprintf(text, sizeof(text), "%.*f", digits, v);
+  return text;
+}
+
+}  // namespace
+
+MissionResult RunMission(const MissionOptions& options) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  MissionResult result;
+  result.scenario = options.scenario;
+  const Scenario scenario =
+      LoadScenario(FindScenario(DefaultScenarioDir(), options.scenario), DefaultSimConfigDir());
+  const World world = World::Generate(scenario.world, options.seed);
+  const RoverTrajectory trajectory(scenario.route, world.terrain);
+  const Time start = kDatasetStartTime;
+  double duration_s = trajectory.duration_s();
+  if (options.max_duration_s > 0.0) duration_s = std::min(duration_s, options.max_duration_s);
+  const Time end = start + Duration::FromSeconds(duration_s);
+  result.sim_duration_s = duration_s;
+
+  // The recording rover's sensors, seeded as `rover-sim generate` seeds them.
+  ImuModelOptions imu_options = scenario.imu;
+  imu_options.seed = scenario.imu.seed ^ (options.seed * 0x9E3779B97F4A7C15ULL);
+  WheelOdometryOptions wheel_options;
+  if (!scenario.wheels_config.empty()) {
+    wheel_options = WheelOdometryOptions::LoadFile(scenario.wheels_config);
+  }
+  const drivers::ReplayClock clock(!options.lockstep, start);
+  SimImuDriver imu(imu_options, trajectory, clock, start, end);
+  SimWheelCanBus can(wheel_options, trajectory, world.terrain, clock, start, end);
+  StereoRenderer renderer(world, scenario.camera);
+  renderer.ReleaseThread();  // it renders on roverd's camera thread
+  const GpioEdgeModel triggers(scenario.gpio, start);
+  const std::vector<const RoverTrajectory*> carriers;  // no other rovers in the mission yet
+  SimStereoCameraDriver camera(renderer, trajectory, carriers, kNoHiddenCarrier, triggers, clock,
+                               start, end);
+
+  roverd::RoverdOptions rover;
+  rover.estimator = EskfOptionsForScenario(scenario, trajectory, wheel_options, true);
+  rover.estimator.clones.max_clones = estimator::kMaxClones;  // 5 keyframes + frames in flight
+  roverd::CameraSetup head;
+  head.cam0 = CameraModelOf(scenario.camera, scenario.camera.T_body_cam0);
+  head.cam1 = CameraModelOf(scenario.camera, scenario.camera.T_body_cam1());
+  head.vo.checks.nominal_rate_hz = scenario.camera.rate_hz;
+  rover.camera = head;
+  rover.lockstep = options.lockstep;
+
+  fs::create_directories(options.out_dir);
+  result.log_path =
+      (fs::path(options.out_dir) / ("mission-" + options.scenario + ".mcap")).string();
+  fs::remove(result.log_path);
+  log::FlightLog flight_log;
+  flight_log.Open(result.log_path);
+  flight_log.WriteMetadata("mission", {{"scenario", options.scenario},
+                                       {"seed", std::to_string(options.seed)},
+                                       {"lockstep", options.lockstep ? "true" : "false"}});
+  const roverd::EstimatorLogChannels channels =
+      roverd::EstimatorLogChannels::Add(&flight_log, rover.estimator);
+  flight_log.Start();
+
+  LatestState latest;
+  roverd::Roverd roverd(rover, {&imu, &camera, &can}, channels, &latest);
+  std::atomic<bool> done{false};
+  std::thread status([&] {
+    while (!done.load()) {
+      for (int i = 0; i < 10 && !done.load(); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      if (done.load() || !options.status) continue;
+      const LatestState::Snapshot s = latest.Read();
+      const roverd::EstimatorLoopStats loop = roverd.loop().stats();
+      std::string line = "t " + Fixed((s.stamp - start).ToSeconds(), 1) + "/" +
+                         Fixed(duration_s, 0) + " s  inputs " + std::to_string(loop.inputs);
+      if (s.initialised && latest.init_stamp_ns()) {
+        const Eigen::Vector3d truth = TrueInFrame0(
+            trajectory, start, Time::FromNanoseconds(*latest.init_stamp_ns()), s.stamp);
+        line += "  p " + Fixed(s.p.x(), 2) + " " + Fixed(s.p.y(), 2) + " " + Fixed(s.p.z(), 2) +
+                " m  err " + Fixed((truth - s.p).norm(), 3) + " m";
+      } else {
+        line += "  (filter initialising)";
+      }
+      options.status(line);
+    }
+  });
+  result.stats = roverd.Run();
+  done.store(true);
+  status.join();
+  flight_log.Stop();
+  const log::FlightLogStats log_stats = flight_log.stats();
+  result.log_records = log_stats.written;
+  result.log_drops = log_stats.dropped;
+  if (!log_stats.error.empty()) throw std::runtime_error(result.log_path + ": " + log_stats.error);
+
+  const LatestState::Snapshot last = latest.Read();
+  if (last.initialised && latest.init_stamp_ns()) {
+    const Time init = Time::FromNanoseconds(*latest.init_stamp_ns());
+    result.filter_initialised = true;
+    result.filter_final_error_m =
+        (TrueInFrame0(trajectory, start, init, last.stamp) - last.p).norm();
+    result.distance_m =
+        DistanceDriven(trajectory, (init - start).ToSeconds(), (last.stamp - start).ToSeconds());
+    result.filter_final_error_pct = result.distance_m > 0.0
+                                        ? 100.0 * result.filter_final_error_m / result.distance_m
+                                        : std::numeric_limits<double>::quiet_NaN();
+  }
+  result.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return result;
+}
+
+void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
+  const roverd::RoverdStats& s = r.stats;
+  out << "mission " << r.scenario << ": " << Fixed(r.sim_duration_s, 1) << " s simulated in "
+      << Fixed(r.wall_time_s, 1) << " s wall time\n";
+  out << "  IMU     " << s.imu_samples << " samples, " << s.imu_drops << " dropped, "
+      << s.imu_errors << " errors\n";
+  out << "  camera  " << s.frames << " frames, " << s.frame_drops << " dropped; VO "
+      << s.vo_measurements << " relative poses (" << s.vo.keyframes << " keyframes, "
+      << s.vo.restarts << " restarts, " << s.vo.Count(estimator::vo::VoStatus::kTextureless)
+      << " textureless)\n";
+  out << "  CAN     " << s.can.syncs << " SYNC periods, " << s.wheel_readings << " wheel readings, "
+      << s.can.incomplete << " incomplete, " << s.can_errors << " errors\n";
+  std::string reasons;
+  for (int k = 0; k <= static_cast<int>(estimator::RejectReason::kNumerical); ++k) {
+    const auto reason = static_cast<estimator::RejectReason>(k);
+    const uint64_t n = s.filter.Rejected(estimator::InputKind::kRelativePose, reason);
+    if (n == 0) continue;
+    reasons += std::string(reasons.empty() ? " (" : ", ") + estimator::ToString(reason) + " " +
+               std::to_string(n);
+  }
+  if (!reasons.empty()) reasons += ")";
+  out << "  filter  " << s.loop.inputs << " inputs; relative poses accepted "
+      << s.filter.Accepted(estimator::InputKind::kRelativePose) << ", rejected "
+      << s.filter.Rejected(estimator::InputKind::kRelativePose) << reasons
+      << "; wheel speeds accepted " << s.filter.Accepted(estimator::InputKind::kWheelSpeeds)
+      << "; late inputs " << s.loop.late_inputs << ", ring drops " << s.loop.ring_drops << "\n";
+  out << "  loop    step wall time p50 " << Fixed(s.step_latency.p50_us, 1) << " us, p99 "
+      << Fixed(s.step_latency.p99_us, 1) << " us, p99.9 " << Fixed(s.step_latency.p999_us, 1)
+      << " us, max " << Fixed(s.step_latency.max_us, 1) << " us\n";
+  if (r.filter_initialised) {
+    out << "  error   " << Fixed(r.filter_final_error_m, 3) << " m after " << Fixed(r.distance_m, 1)
+        << " m (" << Fixed(r.filter_final_error_pct, 3)
+        << " % of distance), against the simulator's ground truth\n";
+  } else {
+    out << "  error   the filter never initialised\n";
+  }
+  out << "  log     " << r.log_path << " (" << r.log_records << " records, " << r.log_drops
+      << " dropped); replay it with `rover replay " << r.log_path << "`\n";
+  const auto num = [](double v, int digits) { return std::isfinite(v) ? Fixed(v, digits) : "nan"; };
+  out << "RESULT scenario=" << r.scenario << " distance_m=" << num(r.distance_m, 3)
+      << " filter_final_err_pct="
+      << (r.filter_initialised ? num(r.filter_final_error_pct, 4) : std::string("nan"))
+      << " slam_final_err_pct=nan imu_drops=" << s.imu_drops << " frame_drops=" << s.frame_drops
+      << " loop_latency_us_p999=" << num(s.step_latency.p999_us, 1) << " log=" << r.log_path
+      << "\n";
+}
+
+}  // namespace rover::sim

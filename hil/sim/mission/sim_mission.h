@@ -1,0 +1,50 @@
+#ifndef ROVER_HIL_SIM_MISSION_SIM_MISSION_H_
+#define ROVER_HIL_SIM_MISSION_SIM_MISSION_H_
+
+// The main job: roverd's threads (firmware/roverd) on the simulator's
+// drivers (IMU, rendered stereo pair, wheel drives on CAN) for a scenario,
+// in real time or lockstep, writing the flight log, with a live status line
+// and a summary scored against the simulator's ground truth.
+
+#include <functional>
+#include <string>
+
+#include "firmware/roverd/roverd.h"
+
+namespace rover::sim {
+
+struct MissionOptions {
+  std::string scenario = "short";
+  uint64_t seed = 1;
+  bool lockstep = true;
+  std::string out_dir = "build/mission";
+  double max_duration_s = 0.0;  ///< 0: the whole route
+  /// Called about once per second of wall time with one status line.
+  std::function<void(const std::string& line)> status;
+};
+
+struct MissionResult {
+  std::string scenario;
+  std::string log_path;
+  double sim_duration_s = 0.0;
+  double wall_time_s = 0.0;
+  double distance_m = 0.0;  ///< horizontal distance between filter start and end
+  /// |p_true - p| at the end in the filter's frame 0 (defined by the true
+  /// pose at its initialisation; roverd switches no frames without mapd).
+  double filter_final_error_m = 0.0;
+  double filter_final_error_pct = 0.0;
+  bool filter_initialised = false;
+  roverd::RoverdStats stats;
+  uint64_t log_records = 0;
+  uint64_t log_drops = 0;
+};
+
+/// Runs the mission. Throws on bad options or an unusable set-up (naming it).
+MissionResult RunMission(const MissionOptions& options);
+
+/// The summary, ending with the RESULT line of the command-line contract.
+void PrintMissionSummary(const MissionResult& result, std::ostream& out);
+
+}  // namespace rover::sim
+
+#endif  // ROVER_HIL_SIM_MISSION_SIM_MISSION_H_
