@@ -21,7 +21,8 @@ Roverd::Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
       drivers_(drivers),
       loop_(options.estimator, channels, listener, options.lockstep),
       gate_(drivers.camera != nullptr && options.camera.has_value(), drivers.can != nullptr,
-            options.lockstep_vo_latency, options.lockstep_lead) {
+            options.lockstep_vo_latency, options.lockstep_lead),
+      probe_(Duration::FromSeconds(1.0 / options.estimator.imu.rate_hz)) {
   if (drivers_.imu == nullptr) throw std::invalid_argument("roverd: expected an IMU driver");
   if (options_.camera && drivers_.camera != nullptr) {
     std::string error;
@@ -39,9 +40,7 @@ Roverd::Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
 
 Roverd::~Roverd() {
   Stop();
-  for (std::thread& t : threads_) {
-    if (t.joinable()) t.join();
-  }
+  threads_.clear();  // joins
 }
 
 void Roverd::Stop() {
@@ -50,17 +49,22 @@ void Roverd::Stop() {
 }
 
 RoverdStats Roverd::Run() {
+  const auto start = [this](runtime::RtThreadOptions options, std::function<void()> body) {
+    if (options_.lockstep) options.priority = 0;  // the threads wait on each other
+    threads_.push_back(std::make_unique<runtime::RtThread>(
+        options, [body = std::move(body)](std::stop_token) { body(); }));
+    thread_reports_.push_back(threads_.back()->report().Describe());
+  };
   if (vo_) {
-    threads_.emplace_back([this] { CameraThread(); });
-    threads_.emplace_back([this] { VoThread(); });
+    start(options_.camera_thread, [this] { CameraThread(); });
+    start(options_.vo_thread, [this] { VoThread(); });
   }
-  if (drivers_.can != nullptr) threads_.emplace_back([this] { CanThread(); });
+  if (drivers_.can != nullptr) start(options_.can_thread, [this] { CanThread(); });
   RoverdStats stats;
   ImuLoop(&stats);
   Stop();
-  for (std::thread& t : threads_) t.join();
-  threads_.clear();
-  loop_.Drain();  // inputs handed over after the last IMU sample still reach the log
+  threads_.clear();  // joins
+  loop_.Drain();     // inputs handed over after the last IMU sample still reach the log
   stats.frames = frames_.load();
   stats.frame_drops = frame_drops_.load();
   stats.vo_measurements = vo_measurements_.load();
@@ -70,7 +74,10 @@ RoverdStats Roverd::Run() {
   stats.can_errors = can_errors_.load();
   stats.loop = loop_.stats();
   stats.filter = loop_.filter().health();
-  stats.step_latency = step_latency_.Get();
+  stats.step_latency = step_latency_.Summarize();
+  stats.sample_to_estimate = probe_.sample_to_estimate().Summarize();
+  stats.sample_to_read = probe_.wakeup_latency().Summarize();
+  stats.thread_reports = thread_reports_;
   return stats;
 }
 
@@ -92,8 +99,13 @@ void Roverd::ImuLoop(RoverdStats* stats) {
     last_sequence = sample.sequence;
     if (options_.lockstep) gate_.WaitBeforeImu(sample.stamp);
     const Time start = Time::Now();
+    // With real sensors the stamps are on CLOCK_MONOTONIC: how old the sample
+    // is when read, and when its estimate is out, are the loop's latencies.
+    if (!options_.lockstep) probe_.OnWake(sample.stamp, start);
     loop_.Step({sample.stamp, sample.angular_velocity_rad_s, sample.linear_acceleration_m_s2});
-    step_latency_.Record(Time::Now() - start);
+    const Time done = Time::Now();
+    step_latency_.Record((done - start).nanoseconds());
+    if (!options_.lockstep) probe_.OnEstimatePublished(sample.stamp, done);
     if (filter_init_ns_.load(std::memory_order_relaxed) == 0 && loop_.filter().initialised()) {
       filter_init_ns_.store(sample.stamp.nanoseconds(), std::memory_order_release);
     }

@@ -17,7 +17,6 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
-#include <thread>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -30,7 +29,10 @@
 #include "estimator/vo/stereo_odometry.h"
 #include "firmware/roverd/estimator_loop.h"
 #include "firmware/roverd/lockstep_gate.h"
-#include "firmware/roverd/step_latency.h"
+#include "firmware/runtime/rt/latency_histogram.h"
+#include "firmware/runtime/rt/loop_probe.h"
+#include "firmware/runtime/rt/rt_thread.h"
+#include "firmware/runtime/rt/rt_thread_options.h"
 
 namespace rover::roverd {
 
@@ -55,6 +57,12 @@ struct RoverdOptions {
   int frame_slots = 3;
   /// Driver read timeouts; a silent sensor is noticed this often.
   Duration read_timeout = Duration::Milliseconds(200);
+  /// Scheduling of the worker threads (DESIGN.md). In lockstep every thread
+  /// runs at normal priority, since they wait on each other. The IMU loop
+  /// runs on the thread that calls Run(); its caller sets that up.
+  runtime::RtThreadOptions camera_thread{"camera", 70, 0, {}, 64 * 1024};
+  runtime::RtThreadOptions can_thread{"can", 60, 0, {}, 64 * 1024};
+  runtime::RtThreadOptions vo_thread{"vo", 0, 10, {}, 64 * 1024};
 };
 
 /// The sensors. `camera` and `can` may be null (that sensor is absent).
@@ -78,7 +86,13 @@ struct RoverdStats {
   uint64_t can_errors = 0;
   EstimatorLoopStats loop;
   estimator::EskfHealth filter;
-  StepLatency::Percentiles step_latency;  ///< wall time of EstimatorLoop::Step
+  runtime::LatencySummary step_latency;  ///< wall time of EstimatorLoop::Step
+  /// Real time only (sensor stamps on CLOCK_MONOTONIC): from the IMU sample's
+  /// time to the estimate it produced, and to the read returning it.
+  runtime::LatencySummary sample_to_estimate;
+  runtime::LatencySummary sample_to_read;
+  /// How each worker thread was scheduled (empty entries: not started).
+  std::vector<std::string> thread_reports;
 };
 
 class Roverd {
@@ -117,7 +131,8 @@ class Roverd {
   EstimatorLoop loop_;
   std::optional<estimator::vo::StereoOdometry> vo_;
   LockstepGate gate_;
-  StepLatency step_latency_;
+  runtime::LatencyHistogram step_latency_;
+  runtime::LoopProbe probe_;
   std::atomic<bool> stop_{false};
   std::atomic<int64_t> filter_init_ns_{0};  ///< IMU stamp when the filter started; 0: not yet
 
@@ -130,7 +145,8 @@ class Roverd {
   std::atomic<uint64_t> wheel_readings_{0};
   std::atomic<uint64_t> can_errors_{0};
   drivers::WheelSpeedDecoder decoder_;  // CAN thread only; read after join
-  std::vector<std::thread> threads_;
+  std::vector<std::unique_ptr<runtime::RtThread>> threads_;
+  std::vector<std::string> thread_reports_;
 };
 
 }  // namespace rover::roverd

@@ -11,6 +11,8 @@
 
 #include "core/log/flight/flight_log.h"
 #include "drivers/replay/euroc_replay.h"
+#include "firmware/runtime/rt/rt_setup.h"
+#include "firmware/runtime/rt/rt_thread.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/estimator_feed/filter_run.h"
 #include "hil/sim/live/sim_can_bus.h"
@@ -127,12 +129,21 @@ MissionResult RunMission(const MissionOptions& options) {
       LoadScenario(FindScenario(DefaultScenarioDir(), options.scenario), DefaultSimConfigDir());
   const World world = World::Generate(scenario.world, options.seed);
   const RoverTrajectory trajectory(scenario.route, world.terrain);
-  const Time start = kDatasetStartTime;
   double duration_s = trajectory.duration_s();
   if (options.max_duration_s > 0.0) duration_s = std::min(duration_s, options.max_duration_s);
-  const Time end = start + Duration::FromSeconds(duration_s);
   result.sim_duration_s = duration_s;
-
+  StereoRenderer renderer(world, scenario.camera);  // slow: before the clock starts
+  renderer.ReleaseThread();                         // it renders on roverd's camera thread
+  if (!options.lockstep) {
+    // Real time: memory locked before the sensors start (locking takes a
+    // while); without the privileges it degrades, and says so once.
+    const runtime::RtSetupReport setup = runtime::RtSetup::Apply({.program_name = "roverd-sim"});
+    if (!setup.warning.empty()) std::fprintf(stderr, "%s\n", setup.warning.c_str());
+  }
+  // Lockstep uses the datasets' fixed time origin; in real time the sensors
+  // stamp on CLOCK_MONOTONIC, as real ones do, from now on.
+  const Time start = options.lockstep ? kDatasetStartTime : Time::Now();
+  const Time end = start + Duration::FromSeconds(duration_s);
   // The recording rover's sensors, seeded as `rover-sim generate` seeds them.
   ImuModelOptions imu_options = scenario.imu;
   imu_options.seed = scenario.imu.seed ^ (options.seed * 0x9E3779B97F4A7C15ULL);
@@ -143,8 +154,6 @@ MissionResult RunMission(const MissionOptions& options) {
   const drivers::ReplayClock clock(!options.lockstep, start);
   SimImuDriver imu(imu_options, trajectory, clock, start, end);
   SimWheelCanBus can(wheel_options, trajectory, world.terrain, clock, start, end);
-  StereoRenderer renderer(world, scenario.camera);
-  renderer.ReleaseThread();  // it renders on roverd's camera thread
   const GpioEdgeModel triggers(scenario.gpio, start);
   const std::vector<const RoverTrajectory*> carriers;  // no other rovers in the mission yet
   SimStereoCameraDriver camera(renderer, trajectory, carriers, kNoHiddenCarrier, triggers, clock,
@@ -197,7 +206,16 @@ MissionResult RunMission(const MissionOptions& options) {
       options.status(line);
     }
   });
-  result.stats = roverd.Run();
+  if (options.lockstep) {
+    result.stats = roverd.Run();
+  } else {
+    // Real time: the IMU loop gets its SCHED_FIFO thread (DESIGN.md).
+    runtime::RtThread imu_thread({"imu", 80, 0, {}, 256 * 1024},
+                                 [&](std::stop_token) { result.stats = roverd.Run(); });
+    imu_thread.Join();
+    result.stats.thread_reports.insert(result.stats.thread_reports.begin(),
+                                       imu_thread.report().Describe());
+  }
   done.store(true);
   status.join();
   flight_log.Stop();
@@ -249,9 +267,16 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
       << s.filter.Rejected(estimator::InputKind::kRelativePose) << reasons
       << "; wheel speeds accepted " << s.filter.Accepted(estimator::InputKind::kWheelSpeeds)
       << "; late inputs " << s.loop.late_inputs << ", ring drops " << s.loop.ring_drops << "\n";
-  out << "  loop    step wall time p50 " << Fixed(s.step_latency.p50_us, 1) << " us, p99 "
-      << Fixed(s.step_latency.p99_us, 1) << " us, p99.9 " << Fixed(s.step_latency.p999_us, 1)
-      << " us, max " << Fixed(s.step_latency.max_us, 1) << " us\n";
+  const auto us = [](int64_t ns) { return Fixed(static_cast<double>(ns) / 1000.0, 1); };
+  out << "  loop    estimator step wall time p50 " << us(s.step_latency.p50_ns) << " us, p99 "
+      << us(s.step_latency.p99_ns) << " us, p99.9 " << us(s.step_latency.p999_ns) << " us, max "
+      << us(s.step_latency.max_ns) << " us\n";
+  if (s.sample_to_estimate.count > 0) {
+    out << "          IMU sample to estimate p50 " << us(s.sample_to_estimate.p50_ns) << " us, p99 "
+        << us(s.sample_to_estimate.p99_ns) << " us, p99.9 " << us(s.sample_to_estimate.p999_ns)
+        << " us, max " << us(s.sample_to_estimate.max_ns) << " us\n";
+  }
+  for (const std::string& t : s.thread_reports) out << "  thread  " << t << "\n";
   if (r.filter_initialised) {
     out << "  error   " << Fixed(r.filter_final_error_m, 3) << " m after " << Fixed(r.distance_m, 1)
         << " m (" << Fixed(r.filter_final_error_pct, 3)
@@ -266,8 +291,12 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
       << " filter_final_err_pct="
       << (r.filter_initialised ? num(r.filter_final_error_pct, 4) : std::string("nan"))
       << " slam_final_err_pct=nan imu_drops=" << s.imu_drops << " frame_drops=" << s.frame_drops
-      << " loop_latency_us_p999=" << num(s.step_latency.p999_us, 1) << " log=" << r.log_path
-      << "\n";
+      << " loop_latency_us_p999="
+      << num(static_cast<double>(s.sample_to_estimate.count > 0 ? s.sample_to_estimate.p999_ns
+                                                                : s.step_latency.p999_ns) /
+                 1000.0,
+             1)
+      << " log=" << r.log_path << "\n";
 }
 
 }  // namespace rover::sim
