@@ -56,6 +56,11 @@ RoverdStats Roverd::Run() {
     thread_reports_.push_back(threads_.back()->report().Describe());
   };
   if (vo_) {
+    if (TriggerClones()) {
+      runtime::RtThreadOptions trigger = options_.camera_thread;
+      trigger.name = "trigger";
+      start(trigger, [this] { TriggerThread(); });
+    }
     start(options_.camera_thread, [this] { CameraThread(); });
     start(options_.vo_thread, [this] { VoThread(); });
   }
@@ -134,7 +139,7 @@ void Roverd::CameraThread() {
     }
     last_sequence = frame.sequence;
     if (options_.lockstep) gate_.FrameArrived(frame.stamp);
-    loop_.PushCloneTrigger({frame.stamp});
+    if (!TriggerClones()) loop_.PushCloneTrigger({frame.stamp});
     const int slot = AcquireSlot();
     if (slot < 0) {
       frame_drops_.fetch_add(1, std::memory_order_relaxed);
@@ -155,6 +160,15 @@ void Roverd::CameraThread() {
     to_vo_.TryPush(slot);  // never full: it holds at most frame_slots entries
   }
   gate_.CameraEnded();
+}
+
+void Roverd::TriggerThread() {
+  Time stamp;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    const drivers::ReadStatus status = drivers_.trigger->Next(&stamp, options_.read_timeout);
+    if (status == drivers::ReadStatus::kEndOfStream) break;
+    if (status == drivers::ReadStatus::kOk) loop_.PushCloneTrigger({stamp});
+  }
 }
 
 void Roverd::VoThread() {

@@ -22,6 +22,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/ring/spsc_ring.h"
+#include "drivers/camera/camera_trigger.h"
 #include "drivers/camera/stereo_camera_driver.h"
 #include "drivers/can/can_bus.h"
 #include "drivers/can/wheel_speed_decoder.h"
@@ -65,10 +66,13 @@ struct RoverdOptions {
   runtime::RtThreadOptions vo_thread{"vo", 0, 10, {}, 64 * 1024};
 };
 
-/// The sensors. `camera` and `can` may be null (that sensor is absent).
+/// The sensors. `camera`, `trigger` and `can` may be null (absent). With a
+/// trigger, clone requests go out at each trigger edge (real time); without
+/// one, or in lockstep, at each frame's arrival.
 struct RoverdDrivers {
   drivers::ImuDriver* imu = nullptr;
   drivers::StereoCameraDriver* camera = nullptr;
+  drivers::CameraTrigger* trigger = nullptr;
   drivers::CanBus* can = nullptr;
 };
 
@@ -122,6 +126,9 @@ class Roverd {
 
   void ImuLoop(RoverdStats* stats);
   void CameraThread();
+  void TriggerThread();
+  /// The trigger thread, not the camera thread, requests the clones.
+  bool TriggerClones() const { return drivers_.trigger != nullptr && !options_.lockstep; }
   void VoThread();
   void CanThread();
   int AcquireSlot();

@@ -15,6 +15,7 @@
 #include "firmware/runtime/rt/rt_thread.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/estimator_feed/filter_run.h"
+#include "hil/sim/live/sim_camera_trigger.h"
 #include "hil/sim/live/sim_can_bus.h"
 #include "hil/sim/live/sim_imu_driver.h"
 #include "hil/sim/live/sim_stereo_camera_driver.h"
@@ -183,7 +184,8 @@ MissionResult RunMission(const MissionOptions& options) {
   flight_log.Start();
 
   LatestState latest;
-  roverd::Roverd roverd(rover, {&imu, &camera, &can}, channels, &latest);
+  SimCameraTrigger trigger(triggers, clock, start, end);
+  roverd::Roverd roverd(rover, {&imu, &camera, &trigger, &can}, channels, &latest);
   std::atomic<bool> done{false};
   std::thread status([&] {
     while (!done.load()) {
