@@ -128,16 +128,23 @@ WheelSpeedMeasurement FromMsg(const msgs::EstimatorWheelSpeeds& msg) {
 
 std::optional<EskfInput> FromMsg(const msgs::EstimatorEvent& msg) {
   const Time stamp = Time::FromNanoseconds(msg.stamp_ns);
+  // Built in place: GCC's -O1 sanitizer builds warn (falsely) about copying
+  // a variant temporary into the optional.
+  std::optional<EskfInput> out;
   switch (msg.kind) {
     case msgs::EstimatorEvent::kCloneTrigger:
-      return EskfInput(CloneTrigger{stamp});
+      out.emplace(std::in_place_type<CloneTrigger>, CloneTrigger{stamp});
+      break;
     case msgs::EstimatorEvent::kFrameSwitchRequest:
-      return EskfInput(FrameSwitchRequest{stamp});
+      out.emplace(std::in_place_type<FrameSwitchRequest>, FrameSwitchRequest{stamp});
+      break;
     case msgs::EstimatorEvent::kPoseReportRequest:
-      return EskfInput(PoseReportRequest{stamp, msg.request_id});
+      out.emplace(std::in_place_type<PoseReportRequest>, PoseReportRequest{stamp, msg.request_id});
+      break;
     default:
-      return std::nullopt;
+      break;
   }
+  return out;
 }
 
 }  // namespace rover::estimator::io
