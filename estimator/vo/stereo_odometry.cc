@@ -25,11 +25,6 @@ double RotationAngleRad(const Eigen::Isometry3d& T) {
   return Eigen::AngleAxisd(T.linear()).angle();
 }
 
-bool MeasurementStatus(VoStatus s) {
-  return s == VoStatus::kTracked || s == VoStatus::kNewKeyframe || s == VoStatus::kRevisited ||
-         s == VoStatus::kLeftOnly;
-}
-
 }  // namespace
 
 const char* VoStatusName(VoStatus status) {
@@ -460,7 +455,7 @@ void StereoOdometry::Finish(VoStatus status, std::chrono::steady_clock::time_poi
   health_.last_status = status;
   health_.healthy = status == VoStatus::kTracked || status == VoStatus::kNewKeyframe ||
                     status == VoStatus::kRevisited || status == VoStatus::kFirstKeyframe;
-  if (MeasurementStatus(status) && result->measurement) {
+  if (result->measurement) {
     ++health_.measurements;
     if (result->quality.inflation > 1.0) ++health_.inflated;
   }

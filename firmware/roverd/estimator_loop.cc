@@ -2,8 +2,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <map>
-#include <string>
 #include <thread>
 #include <type_traits>
 #include <utility>
