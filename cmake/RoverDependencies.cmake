@@ -21,6 +21,8 @@ if(NOT ROVER_FUZZ)
   # the OpenSSL/zlib/brotli build it was compiled with); SHA-256 via libcrypto.
   pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
   find_package(OpenSSL REQUIRED COMPONENTS Crypto)
+  # sd_notify (readiness, watchdog, status) of the firmware processes.
+  pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
   if(ROVER_BUILD_TESTS)
     find_package(GTest REQUIRED)
     include(GoogleTest)

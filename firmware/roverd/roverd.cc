@@ -16,10 +16,13 @@ cv::Mat View(const drivers::ImageView& v) {
 }  // namespace
 
 Roverd::Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
-               const EstimatorLogChannels& channels, EstimatorListener* listener)
+               const EstimatorLogChannels& channels, EstimatorListener* listener,
+               MapdLink* mapd_link)
     : options_(options),
       drivers_(drivers),
-      loop_(options.estimator, channels, listener, options.lockstep),
+      mapd_link_(mapd_link),
+      listeners_(listener, mapd_link),
+      loop_(options.estimator, channels, &listeners_, options.lockstep),
       gate_(drivers.camera != nullptr && options.camera.has_value(), drivers.can != nullptr,
             options.lockstep_vo_latency, options.lockstep_lead),
       probe_(Duration::FromSeconds(1.0 / options.estimator.imu.rate_hz)) {
@@ -65,6 +68,7 @@ RoverdStats Roverd::Run() {
     start(options_.vo_thread, [this] { VoThread(); });
   }
   if (drivers_.can != nullptr) start(options_.can_thread, [this] { CanThread(); });
+  if (mapd_link_ != nullptr) start(options_.link_thread, [this] { LinkThread(); });
   RoverdStats stats;
   ImuLoop(&stats);
   Stop();
@@ -140,6 +144,7 @@ void Roverd::CameraThread() {
     last_sequence = frame.sequence;
     if (options_.lockstep) gate_.FrameArrived(frame.stamp);
     if (!TriggerClones()) loop_.PushCloneTrigger({frame.stamp});
+    if (mapd_link_ != nullptr) mapd_link_->PublishFrame(frame);
     const int slot = AcquireSlot();
     if (slot < 0) {
       frame_drops_.fetch_add(1, std::memory_order_relaxed);
@@ -200,6 +205,14 @@ void Roverd::VoThread() {
     }
     free_slots_.TryPush(slot);
     if (options_.lockstep) gate_.FrameDone();
+  }
+}
+
+void Roverd::LinkThread() {
+  const auto period = std::chrono::nanoseconds(options_.link_poll_period.nanoseconds());
+  while (!stop_.load(std::memory_order_relaxed)) {
+    mapd_link_->PollRequests(&loop_);
+    std::this_thread::sleep_for(period);
   }
 }
 

@@ -30,6 +30,7 @@
 #include "estimator/vo/stereo_odometry.h"
 #include "firmware/roverd/estimator_loop.h"
 #include "firmware/roverd/lockstep_gate.h"
+#include "firmware/roverd/mapd_link.h"
 #include "firmware/runtime/rt/latency_histogram.h"
 #include "firmware/runtime/rt/loop_probe.h"
 #include "firmware/runtime/rt/rt_thread.h"
@@ -64,6 +65,10 @@ struct RoverdOptions {
   runtime::RtThreadOptions camera_thread{"camera", 70, 0, {}, 64 * 1024};
   runtime::RtThreadOptions can_thread{"can", 60, 0, {}, 64 * 1024};
   runtime::RtThreadOptions vo_thread{"vo", 0, 10, {}, 64 * 1024};
+  /// The thread taking mapd's requests (with a MapdLink).
+  runtime::RtThreadOptions link_thread{"mapd-link", 0, 0, {}, 64 * 1024};
+  /// How often the link thread looks for mapd's requests.
+  Duration link_poll_period = Duration::Milliseconds(5);
 };
 
 /// The sensors. `camera`, `trigger` and `can` may be null (absent). With a
@@ -103,8 +108,12 @@ class Roverd {
  public:
   /// Sets everything up (threads start in Run()). Throws std::invalid_argument
   /// when the camera calibration is unusable or the IMU driver is missing.
+  /// With a `mapd_link` (which must outlive this), every estimate, frame
+  /// switch and stereo pair goes to mapd and mapd's frame-switch requests
+  /// reach the filter.
   Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
-         const EstimatorLogChannels& channels, EstimatorListener* listener = nullptr);
+         const EstimatorLogChannels& channels, EstimatorListener* listener = nullptr,
+         MapdLink* mapd_link = nullptr);
   ~Roverd();
   Roverd(const Roverd&) = delete;
   Roverd& operator=(const Roverd&) = delete;
@@ -131,10 +140,13 @@ class Roverd {
   bool TriggerClones() const { return drivers_.trigger != nullptr && !options_.lockstep; }
   void VoThread();
   void CanThread();
+  void LinkThread();
   int AcquireSlot();
 
   RoverdOptions options_;
   RoverdDrivers drivers_;
+  MapdLink* mapd_link_;
+  ListenerPair listeners_;  // the caller's listener, then the mapd link
   EstimatorLoop loop_;
   std::optional<estimator::vo::StereoOdometry> vo_;
   LockstepGate gate_;

@@ -31,6 +31,9 @@ int main(int argc, char** argv) {
   app.add_option("--out", options.out_dir, "folder for the flight log")->capture_default_str();
   app.add_option("--max-duration-s", options.max_duration_s,
                  "stop after this much simulated time (default: the whole route)");
+  app.add_option("--ipc", options.ipc_runtime_name,
+                 "talk to mapd over iceoryx under this runtime name (RouDi must run; "
+                 "rover-launch starts it)");
   CLI11_PARSE(app, argc, argv);
   options.lockstep = !realtime;
   const bool tty = isatty(STDERR_FILENO) != 0;

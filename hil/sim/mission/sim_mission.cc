@@ -9,6 +9,7 @@
 #include <ostream>
 #include <thread>
 
+#include "core/ipc/iceoryx_transport.h"
 #include "core/log/flight/flight_log.h"
 #include "drivers/replay/euroc_replay.h"
 #include "firmware/runtime/rt/rt_setup.h"
@@ -46,12 +47,15 @@ estimator::vo::CameraModel CameraModelOf(const StereoCameraOptions& cam,
 class LatestState final : public roverd::EstimatorListener {
  public:
   void OnState(const estimator::EskfOutput& o) override {
+    // Frame switches (requested by mapd) move the local frame; the error
+    // against ground truth is scored in frame 0, so chain them back.
+    const Eigen::Vector3d p0 = p_0_frame_ + R_0_frame_ * o.p_local_body;
     const uint64_t s = seq_.load(std::memory_order_relaxed);
     seq_.store(s + 1, std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_release);
     stamp_ns_.store(o.stamp.nanoseconds(), std::memory_order_relaxed);
     for (std::size_t i = 0; i < 3; ++i) {
-      p_[i].store(o.p_local_body[static_cast<int>(i)], std::memory_order_relaxed);
+      p_[i].store(p0[static_cast<int>(i)], std::memory_order_relaxed);
     }
     initialised_.store((o.status & estimator::kStatusNotInitialised) == 0,
                        std::memory_order_relaxed);
@@ -61,11 +65,16 @@ class LatestState final : public roverd::EstimatorListener {
       init_stamp_ns_ = o.stamp.nanoseconds();  // IMU thread only until the run ends
     }
   }
-  void OnFrameSwitch(const estimator::FrameSwitchRecord&) override {}
+  void OnFrameSwitch(const estimator::FrameSwitchRecord& r) override {
+    p_0_frame_ += R_0_frame_ * r.p_old_new;
+    R_0_frame_ = R_0_frame_ * Eigen::AngleAxisd(r.yaw_old_new_rad, Eigen::Vector3d::UnitZ());
+    frame_switches_.fetch_add(1, std::memory_order_relaxed);
+  }
+  uint64_t frame_switches() const { return frame_switches_.load(std::memory_order_relaxed); }
 
   struct Snapshot {
     Time stamp;
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();  ///< in frame 0
     bool initialised = false;
   };
   Snapshot Read() const {
@@ -90,6 +99,10 @@ class LatestState final : public roverd::EstimatorListener {
   std::array<std::atomic<double>, 3> p_{};
   std::atomic<bool> initialised_{false};
   std::optional<int64_t> init_stamp_ns_;
+  // Frame 0 <- current local frame; IMU thread only.
+  Eigen::Vector3d p_0_frame_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_0_frame_ = Eigen::Matrix3d::Identity();
+  std::atomic<uint64_t> frame_switches_{0};
 };
 
 // The true pose in the filter's frame 0: defined by the true position and
@@ -185,7 +198,17 @@ MissionResult RunMission(const MissionOptions& options) {
 
   LatestState latest;
   SimCameraTrigger trigger(triggers, clock, start, end);
-  roverd::Roverd roverd(rover, {&imu, &camera, &trigger, &can}, channels, &latest);
+  std::unique_ptr<ipc::IceoryxTransport> transport;
+  std::optional<roverd::MapdLink> mapd_link;
+  if (!options.ipc_runtime_name.empty()) {
+    std::string error;
+    transport = ipc::IceoryxTransport::Create({.runtime_name = options.ipc_runtime_name}, &error);
+    if (transport == nullptr) throw std::runtime_error(error);
+    mapd_link.emplace(transport.get());
+    result.ipc = true;
+  }
+  roverd::Roverd roverd(rover, {&imu, &camera, &trigger, &can}, channels, &latest,
+                        mapd_link ? &*mapd_link : nullptr);
   std::atomic<bool> done{false};
   std::thread status([&] {
     while (!done.load()) {
@@ -205,6 +228,10 @@ MissionResult RunMission(const MissionOptions& options) {
       } else {
         line += "  (filter initialising)";
       }
+      if (mapd_link) {
+        line += "  mapd " + std::string(mapd_link->MapdConnected() ? "up" : "DOWN") + ", frame " +
+                std::to_string(latest.frame_switches());
+      }
       options.status(line);
     }
   });
@@ -220,6 +247,8 @@ MissionResult RunMission(const MissionOptions& options) {
   }
   done.store(true);
   status.join();
+  if (mapd_link) result.mapd_link = mapd_link->stats();
+  result.frame_switches = latest.frame_switches();
   flight_log.Stop();
   const log::FlightLogStats log_stats = flight_log.stats();
   result.log_records = log_stats.written;
@@ -279,6 +308,13 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
         << " us, max " << us(s.sample_to_estimate.max_ns) << " us\n";
   }
   for (const std::string& t : s.thread_reports) out << "  thread  " << t << "\n";
+  if (r.ipc) {
+    const roverd::MapdLinkStats& m = r.mapd_link;
+    out << "  mapd    " << m.poses_published << " estimates and " << m.frames_published
+        << " stereo pairs published (" << m.publish_drops << " dropped); " << m.requests
+        << " frame-switch requests (" << m.requests_refused << " refused), " << r.frame_switches
+        << " frame switches\n";
+  }
   if (r.filter_initialised) {
     out << "  error   " << Fixed(r.filter_final_error_m, 3) << " m after " << Fixed(r.distance_m, 1)
         << " m (" << Fixed(r.filter_final_error_pct, 3)

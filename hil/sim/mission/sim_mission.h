@@ -19,6 +19,10 @@ struct MissionOptions {
   bool lockstep = true;
   std::string out_dir = "build/mission";
   double max_duration_s = 0.0;  ///< 0: the whole route
+  /// Connect to RouDi and talk to mapd (estimates, stereo pairs and frame
+  /// switches out, frame-switch requests in) under this iceoryx runtime
+  /// name; empty: run alone.
+  std::string ipc_runtime_name;
   /// Called about once per second of wall time with one status line.
   std::function<void(const std::string& line)> status;
 };
@@ -35,6 +39,9 @@ struct MissionResult {
   double filter_final_error_pct = 0.0;
   bool filter_initialised = false;
   roverd::RoverdStats stats;
+  bool ipc = false;
+  roverd::MapdLinkStats mapd_link;
+  uint64_t frame_switches = 0;
   uint64_t log_records = 0;
   uint64_t log_drops = 0;
 };

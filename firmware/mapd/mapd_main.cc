@@ -1,0 +1,68 @@
+// mapd: the mapping process. Connects to RouDi, follows roverd's estimates,
+// stereo pairs and frame switches, and asks for a new submap when the
+// current one is done. Runs until SIGTERM/SIGINT; prints its submaps then.
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <thread>
+
+#include "core/ipc/iceoryx_transport.h"
+#include "firmware/mapd/mapd.h"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void OnSignal(int) { g_stop = 1; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "mapd: the rover's mapping process. Subscribes to roverd's estimates, stereo pairs and\n"
+      "frame switches over iceoryx (RouDi must run: scripts/roudi.sh start, or the rover-roudi\n"
+      "unit), starts a new submap when the filter's position sigma or the distance driven in\n"
+      "the current one exceeds its limit, and asks roverd for the frame switch that gives it\n"
+      "its origin. Stops on SIGTERM or SIGINT and prints its submaps.\n"};
+  rover::mapd::MapdOptions options;
+  std::string runtime_name = "mapd";
+  double roudi_wait_s = 5.0;
+  app.add_option("--runtime-name", runtime_name, "name registered with RouDi")
+      ->capture_default_str();
+  app.add_option("--submap-distance-m", options.trigger.max_distance_m,
+                 "new submap after this distance driven in the current one")
+      ->capture_default_str();
+  app.add_option("--submap-sigma-m", options.trigger.max_position_sigma_m,
+                 "new submap when the filter's position sigma exceeds this")
+      ->capture_default_str();
+  app.add_option("--roudi-wait-s", roudi_wait_s, "how long to wait for RouDi")
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGTERM, OnSignal);
+  std::signal(SIGINT, OnSignal);
+  try {
+    std::string error;
+    auto transport = rover::ipc::IceoryxTransport::Create(
+        {.runtime_name = runtime_name,
+         .roudi_wait_timeout = rover::Duration::FromSeconds(roudi_wait_s)},
+        &error);
+    if (transport == nullptr) {
+      std::fprintf(stderr, "mapd: %s\n", error.c_str());
+      return 2;
+    }
+    rover::mapd::Mapd mapd(options, transport.get());
+    std::fprintf(stderr, "mapd: running (pid %d)\n", static_cast<int>(::getpid()));
+    while (g_stop == 0) {
+      if (mapd.Poll() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    std::fprintf(stderr, "%s", mapd.Summary().c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mapd: %s\n", e.what());
+    return 2;
+  }
+}

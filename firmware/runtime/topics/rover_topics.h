@@ -1,0 +1,121 @@
+#ifndef ROVER_FIRMWARE_RUNTIME_TOPICS_ROVER_TOPICS_H_
+#define ROVER_FIRMWARE_RUNTIME_TOPICS_ROVER_TOPICS_H_
+
+// What roverd and mapd say to each other over iceoryx (DESIGN.md):
+//
+//   /roverd/pose                  roverd -> mapd   every estimate (IMU rate)
+//   /roverd/stereo_frame          roverd -> mapd   every captured stereo pair
+//   /roverd/frame_switch          roverd -> mapd   every frame switch (graph factor w)
+//   /mapd/frame_switch_request    mapd -> roverd   "start a new submap now"
+//   /mapd/status                  mapd -> anyone   submaps, inputs, restarts
+//
+// Messages are plain fixed-size structs (ipc::Message: copied byte-wise into
+// shared memory), so both processes must be built from the same sources;
+// kTopicsVersion is carried in every message so a stale binary on the other
+// side is noticed instead of misread. Stamps are int64 nanoseconds on the
+// sensors' clock (CLOCK_MONOTONIC on a board, simulated time in lockstep).
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+namespace rover::runtime::topics {
+
+/// Bumped whenever a message below changes layout or meaning.
+inline constexpr uint32_t kTopicsVersion = 1;
+
+inline constexpr std::string_view kPoseTopic = "/roverd/pose";
+inline constexpr std::string_view kStereoFrameTopic = "/roverd/stereo_frame";
+inline constexpr std::string_view kFrameSwitchTopic = "/roverd/frame_switch";
+inline constexpr std::string_view kFrameSwitchRequestTopic = "/mapd/frame_switch_request";
+inline constexpr std::string_view kMapdStatusTopic = "/mapd/status";
+
+/// One estimate of the local reference filter, in its current local frame.
+struct PoseMsg {
+  uint32_t version = kTopicsVersion;
+  uint32_t frame_id = 0;  ///< local frame index; +1 per frame switch
+  int64_t stamp_ns = 0;
+  uint32_t status = 0;  ///< estimator::EskfStatusFlag bits
+  uint32_t reserved = 0;
+  std::array<double, 3> p_local_body_m{};
+  std::array<double, 4> q_local_body_wxyz{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 3> v_local_m_s{};
+  /// Row-major 6x6 covariance over [dp (m); dtheta (rad)] (graph factor v).
+  std::array<double, 36> pose_covariance{};
+  /// sqrt of the largest eigenvalue of the 3x3 position covariance: the
+  /// submap trigger's "position sigma".
+  double position_sigma_m = 0.0;
+};
+
+/// Largest image a StereoFrameMsg carries (mono8).
+inline constexpr uint32_t kMaxFrameWidthPx = 1280;
+inline constexpr uint32_t kMaxFrameHeightPx = 800;
+inline constexpr uint32_t kMaxFramePixels = kMaxFrameWidthPx * kMaxFrameHeightPx;
+
+/// A rectification-free stereo pair as captured (mono8, rows packed without
+/// padding). About 2 MB: it lives in RouDi's 4 MiB pool and is written in
+/// place (zero-copy) by the camera thread.
+struct StereoFrameMsg {
+  uint32_t version = kTopicsVersion;
+  uint32_t width_px = 0;
+  uint32_t height_px = 0;
+  uint32_t reserved = 0;
+  int64_t capture_stamp_ns = 0;
+  uint64_t sequence = 0;  ///< the camera's frame counter
+  // No initialisers: PublishInPlace default-initialises the message in shared
+  // memory, and zeroing 2 MB per frame only to overwrite it would be waste.
+  std::array<uint8_t, kMaxFramePixels> cam0;
+  std::array<uint8_t, kMaxFramePixels> cam1;
+};
+
+/// A frame switch the filter made (graph factor w): the new local frame seen
+/// from the old one, (p, yaw) with a row-major 4x4 covariance over
+/// [dp (m, old frame); dyaw (rad)].
+struct FrameSwitchMsg {
+  uint32_t version = kTopicsVersion;
+  uint32_t old_frame_id = 0;
+  uint32_t new_frame_id = 0;
+  uint32_t reserved = 0;
+  int64_t stamp_ns = 0;
+  std::array<double, 3> p_old_new_m{};
+  double yaw_old_new_rad = 0.0;
+  std::array<double, 16> covariance{};
+};
+
+/// Why mapd asks for a new submap.
+enum class SwitchReason : uint32_t {
+  kDistance = 0,       ///< the distance driven in the submap exceeded its limit
+  kPositionSigma = 1,  ///< the filter's position sigma exceeded its limit
+  kRestart = 2,        ///< mapd (re)started: its earlier submap is gone
+};
+
+/// Returns "distance", "position_sigma" or "restart".
+std::string_view ToString(SwitchReason reason);
+
+/// mapd asks roverd for a frame switch (a new submap).
+struct FrameSwitchRequestMsg {
+  uint32_t version = kTopicsVersion;
+  SwitchReason reason = SwitchReason::kDistance;
+  uint64_t request_id = 0;  ///< counts up per mapd process, from 1
+  /// The pose mapd decided on (its stamp and frame), for the record.
+  int64_t pose_stamp_ns = 0;
+  uint32_t pose_frame_id = 0;
+  uint32_t reserved = 0;
+};
+
+/// mapd's state, published on every change and once a second.
+struct MapdStatusMsg {
+  uint32_t version = kTopicsVersion;
+  int32_t pid = 0;
+  uint32_t submaps = 0;  ///< submaps started by this process
+  uint32_t current_frame_id = 0;
+  uint64_t poses = 0;              ///< received
+  uint64_t frames = 0;             ///< received
+  uint64_t missed = 0;             ///< queue overflows noticed
+  uint64_t requests = 0;           ///< frame switches requested
+  double submap_distance_m = 0.0;  ///< driven in the current submap
+};
+
+}  // namespace rover::runtime::topics
+
+#endif  // ROVER_FIRMWARE_RUNTIME_TOPICS_ROVER_TOPICS_H_

@@ -1,0 +1,147 @@
+// rover-launch: the launcher of the simulated mission. Starts RouDi (unless
+// one already runs), mapd and roverd-sim, restarts mapd whenever it dies
+// (as systemd does on a board: Restart=always), and when roverd-sim is done
+// stops mapd and the RouDi it started. Exits with roverd-sim's status.
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/ipc/iceoryx_transport.h"
+#include "firmware/runtime/process/child_process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using rover::Duration;
+using rover::Time;
+using rover::runtime::ChildProcess;
+
+volatile std::sig_atomic_t g_stop = 0;
+void OnSignal(int) { g_stop = 1; }
+
+void Say(const std::string& text) { std::fprintf(stderr, "rover-launch: %s\n", text.c_str()); }
+
+std::optional<ChildProcess> StartRouDi(const std::string& config, const fs::path& run_dir) {
+  if (rover::ipc::IceoryxTransport::IsRouDiRunning()) {
+    Say("a RouDi is already running; using it");
+    return std::nullopt;
+  }
+  ChildProcess roudi = ChildProcess::Spawn({.argv = {"iox-roudi", "-c", config, "-l", "warning"},
+                                            .output_file = (run_dir / "roudi.log").string()});
+  const Time deadline = Time::Now() + Duration::Seconds(10);
+  while (!rover::ipc::IceoryxTransport::IsRouDiRunning()) {
+    if (const auto status = roudi.TryWait()) {
+      throw std::runtime_error("iox-roudi " + status->Describe() + " during start-up; see " +
+                               (run_dir / "roudi.log").string());
+    }
+    if (deadline < Time::Now()) {
+      throw std::runtime_error("iox-roudi did not accept connections within 10 s; see " +
+                               (run_dir / "roudi.log").string());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  Say("RouDi started (pid " + std::to_string(roudi.pid()) + ")");
+  return roudi;
+}
+
+ChildProcess StartMapd(const std::vector<std::string>& argv, const fs::path& run_dir) {
+  ChildProcess mapd = ChildProcess::Spawn({.argv = argv});
+  std::ofstream(run_dir / "mapd.pid") << mapd.pid() << "\n";
+  return mapd;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "rover-launch: runs the simulated mission as on a board: RouDi (iceoryx broker), mapd\n"
+      "(mapping, restarted whenever it dies) and roverd-sim (roverd on the simulator's\n"
+      "drivers). Arguments after `--` go to roverd-sim, e.g.\n"
+      "  rover-launch --mapd build/dev/firmware/mapd/mapd \\\n"
+      "               --roverd-sim build/dev/hil/sim/mission/roverd-sim -- --sim short\n"
+      "mapd's pid is kept in RUN_DIR/mapd.pid, so a crash can be staged with\n"
+      "  kill -9 $(cat RUN_DIR/mapd.pid)\n"
+      "Exits with roverd-sim's status.\n"};
+  std::string roverd_sim = "roverd-sim";
+  std::string mapd = "mapd";
+  std::string roudi_config = "firmware/config/roudi.toml";
+  std::string run_dir = "build/mission/run";
+  double restart_backoff_s = 1.0;
+  bool no_mapd = false;
+  std::vector<std::string> mapd_args;
+  std::vector<std::string> roverd_args;
+  app.add_option("--roverd-sim", roverd_sim, "roverd-sim executable")->capture_default_str();
+  app.add_option("--mapd", mapd, "mapd executable")->capture_default_str();
+  app.add_option("--mapd-arg", mapd_args, "extra argument for mapd (repeatable)");
+  app.add_flag("--no-mapd", no_mapd, "run roverd-sim with the link but without mapd");
+  app.add_option("--roudi-config", roudi_config, "RouDi TOML config")->capture_default_str();
+  app.add_option("--run-dir", run_dir, "pid files and RouDi's log")->capture_default_str();
+  app.add_option("--restart-backoff-s", restart_backoff_s, "wait before restarting mapd")
+      ->capture_default_str();
+  app.add_option("roverd_args", roverd_args, "arguments for roverd-sim (after --)");
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGTERM, OnSignal);
+  std::signal(SIGINT, OnSignal);
+  try {
+    fs::create_directories(run_dir);
+    std::optional<ChildProcess> roudi = StartRouDi(roudi_config, run_dir);
+    std::vector<std::string> mapd_argv = {mapd};
+    mapd_argv.insert(mapd_argv.end(), mapd_args.begin(), mapd_args.end());
+    std::optional<ChildProcess> mapd_process;
+    if (!no_mapd) {
+      mapd_process = StartMapd(mapd_argv, run_dir);
+      Say("mapd started (pid " + std::to_string(mapd_process->pid()) + ")");
+    }
+    std::vector<std::string> roverd_argv = {roverd_sim, "--ipc", "roverd"};
+    roverd_argv.insert(roverd_argv.end(), roverd_args.begin(), roverd_args.end());
+    ChildProcess roverd = ChildProcess::Spawn({.argv = roverd_argv});
+    int restarts = 0;
+    std::optional<Time> restart_at;
+    std::optional<rover::runtime::ExitStatus> roverd_status;
+    while (!(roverd_status = roverd.TryWait())) {
+      if (g_stop != 0) {
+        Say("stopping on signal");
+        roverd.Signal(SIGTERM);
+        roverd_status = roverd.Terminate(Duration::Seconds(10));
+        break;
+      }
+      if (mapd_process && !restart_at) {
+        if (const auto status = mapd_process->TryWait()) {
+          Say("mapd " + status->Describe() + "; restarting it in " +
+              std::to_string(restart_backoff_s) + " s");
+          restart_at = Time::Now() + Duration::FromSeconds(restart_backoff_s);
+        }
+      }
+      if (restart_at && *restart_at < Time::Now()) {
+        mapd_process = StartMapd(mapd_argv, run_dir);
+        ++restarts;
+        restart_at.reset();
+        Say("mapd restarted (pid " + std::to_string(mapd_process->pid()) + ")");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (mapd_process) {
+      const auto status = mapd_process->Terminate(Duration::Seconds(5));
+      Say("mapd stopped (" + status.Describe() + "), restarted " + std::to_string(restarts) +
+          " times during the mission");
+    }
+    if (roudi) roudi->Terminate(Duration::Seconds(10));
+    fs::remove(fs::path(run_dir) / "mapd.pid");
+    if (!roverd_status->ok()) Say("roverd-sim " + roverd_status->Describe());
+    return roverd_status->exited ? roverd_status->exit_code : 128 + roverd_status->signal;
+  } catch (const std::exception& e) {
+    Say(e.what());
+    return 2;
+  }
+}

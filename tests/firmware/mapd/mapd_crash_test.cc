@@ -1,0 +1,132 @@
+// Crash isolation (DESIGN.md: roverd must keep running when mapd dies):
+// rover-launch runs RouDi's clients roverd-sim (real time) and mapd; the test
+// kills mapd with SIGKILL mid-mission. roverd's IMU loop must show no gap in
+// its log, the launcher must restart mapd, and the new mapd must resume with
+// a new submap: a frame switch after the kill.
+
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/log/mcap/mcap_reader.h"
+#include "core/log/msgs/estimator_msgs.h"
+#include "core/log/msgs/message_traits.h"
+#include "estimator/io/estimator_log_records.h"
+#include "estimator/io/log_replay.h"
+#include "firmware/runtime/process/child_process.h"
+#include "tests/support/roudi_process.h"
+#include "tests/support/temp_dir.h"
+
+namespace rover {
+namespace {
+
+namespace fs = std::filesystem;
+namespace msgs = log::rover_msgs;
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The pid in `path`, once it differs from `other` (0: any).
+pid_t WaitForPid(const fs::path& path, pid_t other, Duration timeout) {
+  const Time deadline = Time::Now() + timeout;
+  while (Time::Now() < deadline) {
+    pid_t pid = 0;
+    std::ifstream(path) >> pid;
+    if (pid > 0 && pid != other) return pid;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return 0;
+}
+
+template <typename Msg>
+std::vector<Msg> ReadTopic(const std::string& log_path, std::string_view topic) {
+  log::McapReader reader = log::McapReader::Open(log_path);
+  log::ReadOptions options;
+  for (const auto& [id, channel] : reader.channels()) {
+    if (channel.topic == topic) options.channel_ids.push_back(id);
+  }
+  std::vector<Msg> out;
+  reader.ForEachMessage(
+      [&](const log::MessageView& m) {
+        Msg msg;
+        EXPECT_TRUE(log::DeserializeMessage(m.data, &msg));
+        out.push_back(msg);
+        return true;
+      },
+      options);
+  return out;
+}
+
+TEST(MapdCrashTest, KillingMapdLeavesNoGapInTheImuLoopAndMapdResumesWithANewSubmap) {
+  std::string reason;
+  auto roudi = testing::RouDiProcess::Start({.config_file = ROVER_ROUDI_CONFIG}, &reason);
+  if (roudi == nullptr) {
+    if (testing::OwnRouDiRequired()) FAIL() << reason;
+    GTEST_SKIP() << reason;
+  }
+  const testing::TempDir dir;
+  const fs::path run_dir = dir.path() / "run";
+  const fs::path output = dir.path() / "launch.txt";
+  const double duration_s = 14.0;
+  runtime::ChildProcess launcher = runtime::ChildProcess::Spawn(
+      {.argv = {ROVER_LAUNCH, "--mapd", ROVER_MAPD, "--roverd-sim", ROVER_ROVERD_SIM, "--run-dir",
+                run_dir.string(), "--restart-backoff-s", "0.5", "--", "--sim", "short", "--seed",
+                "1", "--realtime", "--max-duration-s", std::to_string(duration_s), "--out",
+                dir.path().string()},
+       .output_file = output.string()});
+  const pid_t first = WaitForPid(run_dir / "mapd.pid", 0, Duration::Seconds(30));
+  ASSERT_GT(first, 0) << ReadFile(output);
+  // Let the mission run (the renderer's set-up and the filter's standstill
+  // initialisation take a few seconds), then kill mapd without warning.
+  std::this_thread::sleep_for(std::chrono::seconds(7));
+  const Time killed_at = Time::Now();
+  ASSERT_EQ(::kill(first, SIGKILL), 0);
+  const pid_t second = WaitForPid(run_dir / "mapd.pid", first, Duration::Seconds(10));
+  EXPECT_GT(second, 0) << "mapd was not restarted\n" << ReadFile(output);
+
+  const auto status = launcher.WaitFor(Duration::Seconds(120));
+  ASSERT_TRUE(status.has_value()) << ReadFile(output);
+  const std::string text = ReadFile(output);
+  ASSERT_TRUE(status->ok()) << status->Describe() << "\n" << text;
+  EXPECT_NE(text.find("mapd killed by signal 9"), std::string::npos) << text;
+  EXPECT_NE(text.find("restarted 1 times"), std::string::npos) << text;
+  EXPECT_NE(text.find("imu_drops=0"), std::string::npos) << text;
+
+  const std::string log_path = (dir.path() / "mission-short.mcap").string();
+  // The IMU loop: every sample at 400 Hz, none missing around the kill.
+  const auto imu = ReadTopic<msgs::EstimatorImu>(log_path, estimator::io::kImuInputTopic);
+  ASSERT_GT(imu.size(), 300u);
+  EXPECT_NEAR(static_cast<double>(imu.size()), duration_s * 400.0, 2.0);
+  int64_t max_gap_ns = 0;
+  for (std::size_t i = 1; i < imu.size(); ++i) {
+    max_gap_ns = std::max(max_gap_ns, imu[i].stamp_ns - imu[i - 1].stamp_ns);
+  }
+  EXPECT_LE(max_gap_ns, 3'750'000) << "an IMU sample is missing (period 2.5 ms)";
+  EXPECT_LT(imu.front().stamp_ns, killed_at.nanoseconds());
+  EXPECT_GT(imu.back().stamp_ns, killed_at.nanoseconds() + 2'000'000'000);
+
+  // One switch for the first mapd's submap, one for the restarted mapd's.
+  const auto switches =
+      ReadTopic<msgs::EstimatorFrameSwitch>(log_path, estimator::io::kFrameSwitchRecordTopic);
+  ASSERT_GE(switches.size(), 2u) << text;
+  EXPECT_LT(switches.front().stamp_ns, killed_at.nanoseconds());
+  EXPECT_GT(switches.back().stamp_ns, killed_at.nanoseconds());
+  EXPECT_NE(text.find("restart "), std::string::npos) << "the new mapd's submap\n" << text;
+
+  const estimator::io::ReplayResult replay = estimator::io::ReplayLog(log_path);
+  EXPECT_TRUE(replay.bit_exact) << replay.first_difference;
+  EXPECT_EQ(replay.switches_compared, switches.size());
+}
+
+}  // namespace
+}  // namespace rover
