@@ -17,10 +17,11 @@ cv::Mat View(const drivers::ImageView& v) {
 
 Roverd::Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
                const EstimatorLogChannels& channels, EstimatorListener* listener,
-               MapdLink* mapd_link)
+               MapdLink* mapd_link, ImageLogger* image_logger)
     : options_(options),
       drivers_(drivers),
       mapd_link_(mapd_link),
+      image_logger_(image_logger),
       listeners_(listener, mapd_link),
       loop_(options.estimator, channels, &listeners_, options.lockstep),
       gate_(drivers.camera != nullptr && options.camera.has_value(), drivers.can != nullptr,
@@ -77,6 +78,10 @@ RoverdStats Roverd::Run() {
   stats.frames = frames_.load();
   stats.frame_drops = frame_drops_.load();
   stats.vo_measurements = vo_measurements_.load();
+  if (image_logger_ != nullptr) {
+    stats.images_logged = image_logger_->logged();
+    stats.image_log_drops = image_logger_->dropped();
+  }
   if (vo_) stats.vo = vo_->health();
   stats.wheel_readings = wheel_readings_.load();
   stats.can = decoder_.stats();
@@ -145,6 +150,7 @@ void Roverd::CameraThread() {
     if (options_.lockstep) gate_.FrameArrived(frame.stamp);
     if (!TriggerClones()) loop_.PushCloneTrigger({frame.stamp});
     if (mapd_link_ != nullptr) mapd_link_->PublishFrame(frame);
+    if (image_logger_ != nullptr) image_logger_->OnFrame(frame);
     const int slot = AcquireSlot();
     if (slot < 0) {
       frame_drops_.fetch_add(1, std::memory_order_relaxed);

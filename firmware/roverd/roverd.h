@@ -29,6 +29,7 @@
 #include "drivers/imu/imu_driver.h"
 #include "estimator/vo/stereo_odometry.h"
 #include "firmware/roverd/estimator_loop.h"
+#include "firmware/roverd/image_logger.h"
 #include "firmware/roverd/lockstep_gate.h"
 #include "firmware/roverd/mapd_link.h"
 #include "firmware/runtime/rt/latency_histogram.h"
@@ -89,6 +90,8 @@ struct RoverdStats {
   uint64_t frames = 0;
   uint64_t frame_drops = 0;  ///< frames the camera lost (sequence gaps) or the VO had no slot for
   uint64_t vo_measurements = 0;
+  uint64_t images_logged = 0;
+  uint64_t image_log_drops = 0;
   estimator::vo::VoHealth vo;
   uint64_t wheel_readings = 0;
   drivers::WheelSpeedDecoderStats can;
@@ -110,10 +113,10 @@ class Roverd {
   /// when the camera calibration is unusable or the IMU driver is missing.
   /// With a `mapd_link` (which must outlive this), every estimate, frame
   /// switch and stereo pair goes to mapd and mapd's frame-switch requests
-  /// reach the filter.
+  /// reach the filter. With an `image_logger`, the camera thread logs images.
   Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
          const EstimatorLogChannels& channels, EstimatorListener* listener = nullptr,
-         MapdLink* mapd_link = nullptr);
+         MapdLink* mapd_link = nullptr, ImageLogger* image_logger = nullptr);
   ~Roverd();
   Roverd(const Roverd&) = delete;
   Roverd& operator=(const Roverd&) = delete;
@@ -146,7 +149,8 @@ class Roverd {
   RoverdOptions options_;
   RoverdDrivers drivers_;
   MapdLink* mapd_link_;
-  ListenerPair listeners_;  // the caller's listener, then the mapd link
+  ImageLogger* image_logger_;  // camera thread only
+  ListenerPair listeners_;     // the caller's listener, then the mapd link
   EstimatorLoop loop_;
   std::optional<estimator::vo::StereoOdometry> vo_;
   LockstepGate gate_;

@@ -34,7 +34,13 @@ int main(int argc, char** argv) {
   app.add_option("--ipc", options.ipc_runtime_name,
                  "talk to mapd over iceoryx under this runtime name (RouDi must run; "
                  "rover-launch starts it)");
+  std::string images = "thumbnails";
+  app.add_option("--images", images,
+                 "camera images in the log: none, thumbnails (cam0, ~188 px wide, 1 Hz) or full")
+      ->check(CLI::IsMember({"none", "thumbnails", "full"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  options.images.mode = rover::roverd::ParseImageLogMode(images);
   options.lockstep = !realtime;
   const bool tty = isatty(STDERR_FILENO) != 0;
   options.status = [tty](const std::string& line) {

@@ -194,6 +194,7 @@ MissionResult RunMission(const MissionOptions& options) {
                                        {"lockstep", options.lockstep ? "true" : "false"}});
   const roverd::EstimatorLogChannels channels =
       roverd::EstimatorLogChannels::Add(&flight_log, rover.estimator);
+  roverd::ImageLogger image_logger(options.images, &flight_log);
   flight_log.Start();
 
   LatestState latest;
@@ -208,7 +209,7 @@ MissionResult RunMission(const MissionOptions& options) {
     result.ipc = true;
   }
   roverd::Roverd roverd(rover, {&imu, &camera, &trigger, &can}, channels, &latest,
-                        mapd_link ? &*mapd_link : nullptr);
+                        mapd_link ? &*mapd_link : nullptr, &image_logger);
   std::atomic<bool> done{false};
   std::thread status([&] {
     while (!done.load()) {
@@ -281,7 +282,8 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
   out << "  camera  " << s.frames << " frames, " << s.frame_drops << " dropped; VO "
       << s.vo_measurements << " relative poses (" << s.vo.keyframes << " keyframes, "
       << s.vo.restarts << " restarts, " << s.vo.Count(estimator::vo::VoStatus::kTextureless)
-      << " textureless)\n";
+      << " textureless); " << s.images_logged << " images logged (" << s.image_log_drops
+      << " dropped)\n";
   out << "  CAN     " << s.can.syncs << " SYNC periods, " << s.wheel_readings << " wheel readings, "
       << s.can.incomplete << " incomplete, " << s.can_errors << " errors\n";
   std::string reasons;

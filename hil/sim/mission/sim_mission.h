@@ -23,6 +23,8 @@ struct MissionOptions {
   /// switches out, frame-switch requests in) under this iceoryx runtime
   /// name; empty: run alone.
   std::string ipc_runtime_name;
+  /// Camera images in the log (thumbnails by default).
+  roverd::ImageLogOptions images;
   /// Called about once per second of wall time with one status line.
   std::function<void(const std::string& line)> status;
 };
