@@ -191,6 +191,16 @@ void Roverd::VoThread() {
       Nap();
       continue;
     }
+    // Real time: a VO that fell behind takes the newest pair and drops the
+    // older ones. Working off a backlog would only make every result late
+    // (and, past the filter's max delay, useless); the clones of the skipped
+    // frames are marginalised by the next measurement.
+    int newer = -1;
+    while (!options_.lockstep && to_vo_.TryPop(&newer)) {
+      free_slots_.TryPush(slot);
+      frame_drops_.fetch_add(1, std::memory_order_relaxed);
+      slot = newer;
+    }
     FrameSlot& s = slots_[static_cast<std::size_t>(slot)];
     // The filter holds clones only from its initialisation on: a keyframe
     // captured before cannot be used, so ask for one captured after it.
