@@ -13,6 +13,7 @@
 
 #include "core/ipc/iceoryx_transport.h"
 #include "firmware/mapd/mapd.h"
+#include "firmware/runtime/health/systemd_notifier.h"
 
 namespace {
 
@@ -56,9 +57,20 @@ int main(int argc, char** argv) {
     }
     rover::mapd::Mapd mapd(options, transport.get());
     std::fprintf(stderr, "mapd: running (pid %d)\n", static_cast<int>(::getpid()));
+    // Under systemd (Type=notify, WatchdogSec=): ready now, and alive as
+    // long as this loop turns.
+    const auto notifier = rover::runtime::SystemdNotifier::FromEnvironment();
+    notifier.Ready();
+    const auto ping = notifier.watchdog_ping_period();
+    rover::Time next_ping = rover::Time::Now();
     while (g_stop == 0) {
       if (mapd.Poll() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      if (ping && next_ping < rover::Time::Now()) {
+        notifier.Watchdog();
+        next_ping = rover::Time::Now() + *ping;
+      }
     }
+    notifier.Stopping();
     std::fprintf(stderr, "%s", mapd.Summary().c_str());
     return 0;
   } catch (const std::exception& e) {

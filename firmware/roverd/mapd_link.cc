@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/log/msgs/message_traits.h"
+
 namespace rover::roverd {
 namespace {
 
@@ -38,7 +40,8 @@ void CopyPacked(const drivers::ImageView& view, uint8_t* dst) {
 MapdLink::MapdLink(ipc::Transport* transport)
     : poses_(MakePublisher<topics::PoseMsg>(transport, topics::kPoseTopic)),
       frames_(MakePublisher<topics::StereoFrameMsg>(transport, topics::kStereoFrameTopic)),
-      switches_(MakePublisher<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic)) {
+      switches_(MakePublisher<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic)),
+      diagnostics_(MakePublisher<topics::DiagnosticsMsg>(transport, topics::kDiagnosticsTopic)) {
   std::string error;
   const std::optional<ipc::Topic> topic =
       ipc::Topic::Parse(topics::kFrameSwitchRequestTopic, &error);
@@ -135,6 +138,13 @@ int MapdLink::PollRequests(EstimatorLoop* loop) {
     ++handed;
   }
   return handed;
+}
+
+bool MapdLink::PublishDiagnostics(const log::diagnostic_msgs::DiagnosticArray& diagnostics) {
+  if (log::SerializedSize(diagnostics) > topics::DiagnosticsMsg::kMaxCdrBytes) return false;
+  return diagnostics_->PublishInPlace([&diagnostics](topics::DiagnosticsMsg& m) {
+    m.cdr_size = static_cast<uint32_t>(log::SerializeMessage(diagnostics, m.cdr));
+  });
 }
 
 bool MapdLink::MapdConnected() const { return poses_->HasSubscribers(); }

@@ -17,6 +17,7 @@
 #include <memory>
 
 #include "core/ipc/transport.h"
+#include "core/log/msgs/diagnostic_msgs.h"
 #include "drivers/camera/stereo_frame.h"
 #include "firmware/roverd/estimator_loop.h"
 #include "firmware/runtime/topics/rover_topics.h"
@@ -53,6 +54,10 @@ class MapdLink final : public EstimatorListener {
   /// next IMU sample rather than counting as late. Returns how many.
   int PollRequests(EstimatorLoop* loop);
 
+  /// Health thread: publishes the health report on /roverd/diagnostics.
+  /// False if it does not fit a DiagnosticsMsg or no buffer is free.
+  bool PublishDiagnostics(const log::diagnostic_msgs::DiagnosticArray& diagnostics);
+
   /// True if mapd (any subscriber) listens to the poses. Not real-time.
   bool MapdConnected() const;
 
@@ -62,6 +67,7 @@ class MapdLink final : public EstimatorListener {
   std::unique_ptr<ipc::Publisher<runtime::topics::PoseMsg>> poses_;
   std::unique_ptr<ipc::Publisher<runtime::topics::StereoFrameMsg>> frames_;
   std::unique_ptr<ipc::Publisher<runtime::topics::FrameSwitchMsg>> switches_;
+  std::unique_ptr<ipc::Publisher<runtime::topics::DiagnosticsMsg>> diagnostics_;
   std::unique_ptr<ipc::Subscriber<runtime::topics::FrameSwitchRequestMsg>> requests_;
   std::atomic<int64_t> latest_stamp_ns_{0};
   std::atomic<uint64_t> requests_handed_{0};

@@ -21,6 +21,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/log/msgs/diagnostic_msgs.h"
 #include "core/ring/spsc_ring.h"
 #include "drivers/camera/camera_trigger.h"
 #include "drivers/camera/stereo_camera_driver.h"
@@ -32,6 +33,10 @@
 #include "firmware/roverd/image_logger.h"
 #include "firmware/roverd/lockstep_gate.h"
 #include "firmware/roverd/mapd_link.h"
+#include "firmware/runtime/health/health_options.h"
+#include "firmware/runtime/health/health_report.h"
+#include "firmware/runtime/health/sensor_monitor.h"
+#include "firmware/runtime/health/systemd_notifier.h"
 #include "firmware/runtime/rt/latency_histogram.h"
 #include "firmware/runtime/rt/loop_probe.h"
 #include "firmware/runtime/rt/rt_thread.h"
@@ -70,6 +75,24 @@ struct RoverdOptions {
   runtime::RtThreadOptions link_thread{"mapd-link", 0, 0, {}, 64 * 1024};
   /// How often the link thread looks for mapd's requests.
   Duration link_poll_period = Duration::Milliseconds(5);
+  /// The health thread: sensor rates, gaps, drops and latency, filter and
+  /// loop status, once per period to the log, mapd's link and systemd.
+  runtime::HealthOptions health;
+  runtime::RtThreadOptions health_thread{"health", 0, 0, {}, 64 * 1024};
+  /// Nominal rate of the CAN wheel readings (one per SYNC).
+  double wheel_rate_hz = 100.0;
+};
+
+/// The flight-log channel of the health reports.
+using DiagnosticsChannel = log::LogChannel<log::diagnostic_msgs::DiagnosticArray, 16384, 64>;
+
+/// Where roverd's outputs go besides the estimator's log channels; each may
+/// be null. They must outlive the Roverd.
+struct RoverdOutputs {
+  EstimatorListener* listener = nullptr;      ///< IMU thread, after each estimate
+  MapdLink* mapd_link = nullptr;              ///< estimates, frames, health out; requests in
+  ImageLogger* images = nullptr;              ///< camera thread
+  DiagnosticsChannel* diagnostics = nullptr;  ///< health thread
 };
 
 /// The sensors. `camera`, `trigger` and `can` may be null (absent). With a
@@ -105,18 +128,19 @@ struct RoverdStats {
   runtime::LatencySummary sample_to_read;
   /// How each worker thread was scheduled (empty entries: not started).
   std::vector<std::string> thread_reports;
+  /// Health reports made, and the last one as one line.
+  uint64_t health_reports = 0;
+  std::string health;
+  uint64_t watchdog_pings = 0;
 };
 
 class Roverd {
  public:
   /// Sets everything up (threads start in Run()). Throws std::invalid_argument
-  /// when the camera calibration is unusable or the IMU driver is missing.
-  /// With a `mapd_link` (which must outlive this), every estimate, frame
-  /// switch and stereo pair goes to mapd and mapd's frame-switch requests
-  /// reach the filter. With an `image_logger`, the camera thread logs images.
+  /// when the camera calibration is unusable, the IMU driver is missing or
+  /// the health options are invalid.
   Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
-         const EstimatorLogChannels& channels, EstimatorListener* listener = nullptr,
-         MapdLink* mapd_link = nullptr, ImageLogger* image_logger = nullptr);
+         const EstimatorLogChannels& channels, const RoverdOutputs& outputs = {});
   ~Roverd();
   Roverd(const Roverd&) = delete;
   Roverd& operator=(const Roverd&) = delete;
@@ -144,13 +168,22 @@ class Roverd {
   void VoThread();
   void CanThread();
   void LinkThread();
+  void HealthThread();
+  void SleepFor(Duration d) const;
+  void PublishFilterHealth(Time imu_stamp);
+  /// The clock the sensor monitors run on: CLOCK_MONOTONIC in real time,
+  /// the sensors' own (simulated) stamps in lockstep.
+  Time MonitorClock(Time sensor_stamp) const;
+  /// One health cycle: report to the log, mapd's link and systemd. Health
+  /// thread, or the caller of Run() once it has stopped.
+  void Report(Time wall_now);
+  runtime::HealthReport BuildHealthReport(Time wall_now);
   int AcquireSlot();
 
   RoverdOptions options_;
   RoverdDrivers drivers_;
-  MapdLink* mapd_link_;
-  ImageLogger* image_logger_;  // camera thread only
-  ListenerPair listeners_;     // the caller's listener, then the mapd link
+  RoverdOutputs outputs_;
+  ListenerPair listeners_;  // the caller's listener, then the mapd link
   EstimatorLoop loop_;
   std::optional<estimator::vo::StereoOdometry> vo_;
   LockstepGate gate_;
@@ -168,6 +201,22 @@ class Roverd {
   std::atomic<uint64_t> wheel_readings_{0};
   std::atomic<uint64_t> can_errors_{0};
   drivers::WheelSpeedDecoder decoder_;  // CAN thread only; read after join
+  // Health: one monitor per sensor (producer: its thread; reader: health).
+  runtime::SensorMonitor imu_monitor_;
+  runtime::SensorMonitor camera_monitor_;
+  runtime::SensorMonitor wheel_monitor_;
+  runtime::SystemdNotifier notifier_;
+  // The filter's state as the IMU thread last saw it, for the health thread.
+  std::atomic<uint32_t> filter_status_{0};
+  std::atomic<uint64_t> relative_poses_accepted_{0};
+  std::atomic<uint64_t> relative_poses_rejected_{0};
+  std::atomic<uint64_t> wheel_speeds_accepted_{0};
+  std::atomic<uint64_t> imu_steps_{0};
+  std::atomic<int64_t> latest_imu_ns_{0};
+  // Written by the health thread, read after it is joined.
+  uint64_t health_reports_ = 0;
+  uint64_t watchdog_pings_ = 0;
+  std::string last_health_;
   std::vector<std::unique_ptr<runtime::RtThread>> threads_;
   std::vector<std::string> thread_reports_;
 };

@@ -8,6 +8,7 @@
 //   /roverd/frame_switch          roverd -> mapd   every frame switch (graph factor w)
 //   /mapd/frame_switch_request    mapd -> roverd   "start a new submap now"
 //   /mapd/status                  mapd -> anyone   submaps, inputs, restarts
+//   /roverd/diagnostics           roverd -> anyone health, once per health period
 //
 // Messages are plain fixed-size structs (ipc::Message: copied byte-wise into
 // shared memory), so both processes must be built from the same sources;
@@ -16,6 +17,7 @@
 // sensors' clock (CLOCK_MONOTONIC on a board, simulated time in lockstep).
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string_view>
 
@@ -29,6 +31,7 @@ inline constexpr std::string_view kStereoFrameTopic = "/roverd/stereo_frame";
 inline constexpr std::string_view kFrameSwitchTopic = "/roverd/frame_switch";
 inline constexpr std::string_view kFrameSwitchRequestTopic = "/mapd/frame_switch_request";
 inline constexpr std::string_view kMapdStatusTopic = "/mapd/status";
+inline constexpr std::string_view kDiagnosticsTopic = "/roverd/diagnostics";
 
 /// One estimate of the local reference filter, in its current local frame.
 struct PoseMsg {
@@ -114,6 +117,16 @@ struct MapdStatusMsg {
   uint64_t missed = 0;             ///< queue overflows noticed
   uint64_t requests = 0;           ///< frame switches requested
   double submap_distance_m = 0.0;  ///< driven in the current submap
+};
+
+/// roverd's health report: a diagnostic_msgs/DiagnosticArray as ROS 2 CDR
+/// (the bytes the flight log holds), so any subscriber decodes it with the
+/// log's own message code (log::DeserializeMessage).
+struct DiagnosticsMsg {
+  static constexpr std::size_t kMaxCdrBytes = 32 * 1024;
+  uint32_t version = kTopicsVersion;
+  uint32_t cdr_size = 0;
+  std::array<std::byte, kMaxCdrBytes> cdr;
 };
 
 }  // namespace rover::runtime::topics

@@ -167,11 +167,15 @@ MissionResult RunMission(const MissionOptions& options) {
   }
   const drivers::ReplayClock clock(!options.lockstep, start);
   SimImuDriver imu(imu_options, trajectory, clock, start, end);
-  SimWheelCanBus can(wheel_options, trajectory, world.terrain, clock, start, end);
+  const auto lost_at = [&](double loss_s) {
+    return loss_s > 0.0 ? std::min(end, start + Duration::FromSeconds(loss_s)) : end;
+  };
+  SimWheelCanBus can(wheel_options, trajectory, world.terrain, clock, start,
+                     lost_at(options.can_loss_at_s));
   const GpioEdgeModel triggers(scenario.gpio, start);
   const std::vector<const RoverTrajectory*> carriers;  // no other rovers in the mission yet
   SimStereoCameraDriver camera(renderer, trajectory, carriers, kNoHiddenCarrier, triggers, clock,
-                               start, end);
+                               start, lost_at(options.camera_loss_at_s));
 
   roverd::RoverdOptions rover;
   rover.estimator = EskfOptionsForScenario(scenario, trajectory, wheel_options, true);
@@ -195,10 +199,12 @@ MissionResult RunMission(const MissionOptions& options) {
   const roverd::EstimatorLogChannels channels =
       roverd::EstimatorLogChannels::Add(&flight_log, rover.estimator);
   roverd::ImageLogger image_logger(options.images, &flight_log);
+  roverd::DiagnosticsChannel* diagnostics =
+      flight_log.AddChannel<log::diagnostic_msgs::DiagnosticArray, 16384, 64>("/diagnostics");
   flight_log.Start();
 
   LatestState latest;
-  SimCameraTrigger trigger(triggers, clock, start, end);
+  SimCameraTrigger trigger(triggers, clock, start, lost_at(options.camera_loss_at_s));
   std::unique_ptr<ipc::IceoryxTransport> transport;
   std::optional<roverd::MapdLink> mapd_link;
   if (!options.ipc_runtime_name.empty()) {
@@ -208,8 +214,11 @@ MissionResult RunMission(const MissionOptions& options) {
     mapd_link.emplace(transport.get());
     result.ipc = true;
   }
-  roverd::Roverd roverd(rover, {&imu, &camera, &trigger, &can}, channels, &latest,
-                        mapd_link ? &*mapd_link : nullptr, &image_logger);
+  roverd::Roverd roverd(rover, {&imu, &camera, &trigger, &can}, channels,
+                        {.listener = &latest,
+                         .mapd_link = mapd_link ? &*mapd_link : nullptr,
+                         .images = &image_logger,
+                         .diagnostics = diagnostics});
   std::atomic<bool> done{false};
   std::thread status([&] {
     while (!done.load()) {
@@ -310,6 +319,8 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
         << " us, max " << us(s.sample_to_estimate.max_ns) << " us\n";
   }
   for (const std::string& t : s.thread_reports) out << "  thread  " << t << "\n";
+  out << "  health  " << s.health_reports
+      << " reports to /diagnostics; last: " << (s.health.empty() ? "(none)" : s.health) << "\n";
   if (r.ipc) {
     const roverd::MapdLinkStats& m = r.mapd_link;
     out << "  mapd    " << m.poses_published << " estimates and " << m.frames_published

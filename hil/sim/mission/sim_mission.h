@@ -23,6 +23,12 @@ struct MissionOptions {
   /// switches out, frame-switch requests in) under this iceoryx runtime
   /// name; empty: run alone.
   std::string ipc_runtime_name;
+  /// Fault injection: the cameras (or the CAN bus) go silent for good this
+  /// many simulated seconds into the mission (0: never). The simulator's
+  /// drivers then report the end of their stream, which roverd treats as a
+  /// lost sensor.
+  double camera_loss_at_s = 0.0;
+  double can_loss_at_s = 0.0;
   /// Camera images in the log (thumbnails by default).
   roverd::ImageLogOptions images;
   /// Called about once per second of wall time with one status line.

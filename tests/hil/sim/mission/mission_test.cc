@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <sstream>
 
 #include "estimator/io/log_replay.h"
@@ -52,6 +53,54 @@ TEST(MissionTest, ShortMissionRecordsAndReplaysBitExactly) {
   EXPECT_TRUE(replay.bit_exact) << replay.first_difference;
   EXPECT_EQ(replay.inputs, s.loop.inputs);
   EXPECT_EQ(replay.states_compared, s.loop.states);
+}
+
+}  // namespace
+}  // namespace rover::sim
+
+namespace rover::sim {
+namespace {
+
+// Sensor loss degrades gracefully and visibly (DESIGN.md): the filter keeps
+// running on what is left, and the health report names the lost sensor.
+MissionResult RunWithLoss(double camera_loss_at_s, double can_loss_at_s,
+                          const std::filesystem::path& dir) {
+  MissionOptions options;
+  options.scenario = "short";
+  options.seed = 1;
+  options.lockstep = true;
+  options.out_dir = dir.string();
+  options.max_duration_s = 16.0;
+  options.camera_loss_at_s = camera_loss_at_s;
+  options.can_loss_at_s = can_loss_at_s;
+  options.images.mode = roverd::ImageLogMode::kNone;
+  return RunMission(options);
+}
+
+TEST(MissionTest, LosingTheCamerasLeavesImuAndWheels) {
+  const rover::testing::TempDir dir;
+  const MissionResult r = RunWithLoss(8.0, 0.0, dir.path());
+  const roverd::RoverdStats& s = r.stats;
+  EXPECT_EQ(s.frames, 80u);  // 8 s at 10 Hz, then nothing
+  EXPECT_NEAR(static_cast<double>(s.imu_samples), 6400.0, 1.0);
+  EXPECT_GT(s.wheel_readings, 1500u);  // wheels to the end
+  EXPECT_TRUE(r.filter_initialised);
+  EXPECT_LT(r.filter_final_error_pct, 2.0) << "IMU + wheels alone for 8 s";
+  EXPECT_NE(s.health.find("camera STALE"), std::string::npos) << s.health;
+  EXPECT_NE(s.health.find("wheels ok"), std::string::npos) << s.health;
+}
+
+TEST(MissionTest, LosingTheCanBusLeavesImuAndVo) {
+  const rover::testing::TempDir dir;
+  const MissionResult r = RunWithLoss(0.0, 8.0, dir.path());
+  const roverd::RoverdStats& s = r.stats;
+  EXPECT_EQ(s.frames, 160u);
+  EXPECT_LT(s.wheel_readings, 820u);
+  EXPECT_GT(s.filter.Accepted(estimator::InputKind::kRelativePose), 120u) << "VO to the end";
+  EXPECT_TRUE(r.filter_initialised);
+  EXPECT_LT(r.filter_final_error_pct, 1.0);
+  EXPECT_NE(s.health.find("wheels STALE"), std::string::npos) << s.health;
+  EXPECT_NE(s.health.find("camera ok"), std::string::npos) << s.health;
 }
 
 }  // namespace

@@ -1,0 +1,192 @@
+#ifndef ROVER_FIRMWARE_RUNTIME_BOARD_BOARD_CONFIG_H_
+#define ROVER_FIRMWARE_RUNTIME_BOARD_BOARD_CONFIG_H_
+
+// The board profile: one YAML file per board (firmware/config/*.yaml, the
+// installed one is /etc/rover/board.yaml) that roverd and mapd both read.
+//
+//   board: {name: rover1, profile: replay}      # required; profile: sim | replay
+//   replay: {dataset: /var/lib/rover/dataset}   # required with profile replay, else an error
+//   threads:                                    # each an RtThreadOptions, all optional
+//     imu: {priority: 80}                       # defaults: imu FIFO 80, camera FIFO 70,
+//     camera: {priority: 70}                    # can FIFO 60, vo nice 10, log nice 0,
+//     ...                                       # service nice 10
+//   realtime: {lock_memory: true}
+//   log:                                        # required (folder is)
+//     folder: /var/lib/rover/logs
+//     images: thumbnails                        # none | thumbnails | full
+//     thumbnail_width_px: 188
+//     thumbnail_rate_hz: 1.0
+//   log_service: {...}                          # optional: LogServiceOptions; absent = off
+//   ipc: {roudi_wait_s: 5.0}
+//   health: {period_s: 1.0, stale_after_s: 1.0, rate_warn_fraction: 0.9, watchdog: true}
+//   mapd: {submap_max_distance_m: 7.0, submap_max_position_sigma_m: 0.1,
+//          restart_backoff_s: 1.0}
+//
+// Every section except `board` and `log` is optional and every key in an
+// optional section defaults to the value shown. Unknown keys are errors.
+// Relative paths are relative to the working directory of the process (the
+// repository root for `./rover run`), not to the config file.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "core/config/config.h"
+#include "firmware/runtime/log_service/log_service_options.h"
+#include "firmware/runtime/rt/rt_setup.h"
+#include "firmware/runtime/rt/rt_thread_options.h"
+
+namespace rover::runtime {
+
+/// Which drivers roverd uses. To add one (e.g. real hardware): add the
+/// enumerator, its name in BoardConfig::Load and BoardProfileName, and, if
+/// it needs settings, a section named like the profile (as `replay`).
+enum class BoardProfile {
+  kSim,     ///< "sim": the simulator's drivers (roverd-sim).
+  kReplay,  ///< "replay": a recorded EuRoC-layout dataset replayed as sensors.
+};
+
+/// "sim", "replay": the name used in the YAML file.
+std::string_view BoardProfileName(BoardProfile profile);
+
+/// What the flight log keeps of the camera images.
+enum class LogImages {
+  kNone,        ///< "none": no images (VO results and clone requests only).
+  kThumbnails,  ///< "thumbnails": downscaled cam0 images at thumbnail_rate_hz.
+  kFull,        ///< "full": every frame of both cameras at full resolution.
+};
+
+/// "none", "thumbnails", "full".
+std::string_view LogImagesName(LogImages images);
+
+/// `board:` which board this is and which drivers it runs.
+struct BoardIdentity {
+  static constexpr std::size_t kMaxNameLength = 63;
+  /// Robot name, also used in frame ids (local/<name>/<submap>): 1..63 of
+  /// [A-Za-z0-9_-].
+  std::string name;
+  BoardProfile profile = BoardProfile::kSim;
+};
+
+/// `replay:` (profile replay only).
+struct BoardReplayOptions {
+  /// Folder of a EuRoC-layout dataset (holds mav0/).
+  std::string dataset;
+};
+
+/// `threads:` scheduling of every firmware thread (see DESIGN.md).
+struct BoardThreadOptions {
+  RtThreadOptions imu{"imu", 80, 0, {}, 64 * 1024};
+  RtThreadOptions camera{"camera", 70, 0, {}, 64 * 1024};
+  RtThreadOptions can{"can", 60, 0, {}, 64 * 1024};
+  RtThreadOptions vo{"vo", 0, 10, {}, 64 * 1024};
+  RtThreadOptions log{"log", 0, 0, {}, 64 * 1024};
+  RtThreadOptions service{"service", 0, 10, {}, 64 * 1024};
+};
+
+/// `realtime:` process-wide real-time set-up (RtSetup).
+struct BoardRealtimeOptions {
+  /// mlockall(MCL_CURRENT | MCL_FUTURE) at start-up.
+  bool lock_memory = true;
+
+  /// The RtSetup options for a process named `program_name`.
+  RtSetupOptions ToRtSetupOptions(const std::string& program_name) const;
+};
+
+/// `log:` the flight log.
+struct BoardLogOptions {
+  static constexpr int kMinThumbnailWidthPx = 16;
+  static constexpr int kMaxThumbnailWidthPx = 4096;
+  static constexpr double kMaxThumbnailRateHz = 100.0;
+
+  /// Folder the MCAP flight logs are written to (required, non-empty).
+  std::string folder;
+  LogImages images = LogImages::kThumbnails;
+  /// Width of a thumbnail (height keeps the aspect ratio); 188 = 752 / 4.
+  int thumbnail_width_px = 188;
+  /// Thumbnails per second, in (0, 100].
+  double thumbnail_rate_hz = 1.0;
+};
+
+/// `ipc:` iceoryx.
+struct BoardIpcOptions {
+  static constexpr double kMaxRoudiWaitS = 600.0;
+  /// How long a process waits for RouDi at start-up before giving up, s.
+  double roudi_wait_s = 5.0;
+};
+
+/// `health:` the health monitor and the systemd watchdog. A plain struct so
+/// this header does not depend on firmware/runtime/health; it has the same
+/// keys, defaults and ranges as runtime::HealthOptions there, so either can
+/// read the section.
+struct BoardHealthOptions {
+  static constexpr double kMinPeriodS = 0.01;
+  static constexpr double kMaxPeriodS = 60.0;
+  static constexpr double kMaxStaleAfterS = 60.0;
+  /// How often the health report is computed and published, s.
+  double period_s = 1.0;
+  /// A thread or input without a heartbeat for this long is stale, s.
+  double stale_after_s = 1.0;
+  /// A sensor below this fraction of its nominal rate is a warning, in
+  /// [0, 1]; 0 disables the rate check.
+  double rate_warn_fraction = 0.9;
+  /// Ping the systemd watchdog (sd_notify WATCHDOG=1) while healthy.
+  bool watchdog = true;
+};
+
+/// `mapd:` the mapping process.
+struct BoardMapdOptions {
+  static constexpr double kMaxSubmapDistanceM = 1000.0;
+  static constexpr double kMaxSubmapSigmaM = 100.0;
+  static constexpr double kMaxRestartBackoffS = 600.0;
+  /// Start a new submap after driving this far in the current one, m
+  /// (thesis: 7 m).
+  double submap_max_distance_m = 7.0;
+  /// ... or when the filter's position standard deviation exceeds this, m
+  /// (thesis: 0.1 m).
+  double submap_max_position_sigma_m = 0.1;
+  /// Wait before reconnecting / restarting after a failure, s.
+  double restart_backoff_s = 1.0;
+};
+
+/// The whole board profile.
+struct BoardConfig {
+  BoardIdentity board;
+  /// Present iff board.profile is kReplay.
+  std::optional<BoardReplayOptions> replay;
+  BoardThreadOptions threads;
+  BoardRealtimeOptions realtime;
+  BoardLogOptions log;
+  /// Absent: the HTTP log service is off.
+  std::optional<LogServiceOptions> log_service;
+  BoardIpcOptions ipc;
+  BoardHealthOptions health;
+  BoardMapdOptions mapd;
+
+  /// Reads and validates the YAML file at `path` (see Load). Throws
+  /// ConfigError "path:line: key.path: expected ..., found ...".
+  static BoardConfig LoadFile(const std::string& path);
+
+  /// Reads every section from `root` (a whole document), validates the
+  /// result (Validate's checks, located at the offending key) and rejects
+  /// keys nobody read (root.CheckNoUnknownKeysRecursive()). Throws ConfigError.
+  static BoardConfig Load(const ConfigNode& root);
+
+  /// Throws std::invalid_argument "key.path: expected ..., found ..." for the
+  /// first invalid value: any RtThreadOptions problem; thread names not
+  /// unique; a thread with a higher SCHED_FIFO priority than the IMU thread;
+  /// a bad board name; replay options present iff the profile is replay,
+  /// with a non-empty dataset; an empty log folder or thumbnail settings out
+  /// of range; log_service invalid or serving a folder other than
+  /// log.folder; ipc, health and mapd values out of the ranges above (every
+  /// duration and distance > 0, the backoff and RouDi wait >= 0).
+  void Validate() const;
+};
+
+/// Where the installed board config lives: "/etc/rover/board.yaml".
+std::string DefaultBoardConfigPath();
+
+}  // namespace rover::runtime
+
+#endif  // ROVER_FIRMWARE_RUNTIME_BOARD_BOARD_CONFIG_H_
