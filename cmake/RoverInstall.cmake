@@ -66,9 +66,10 @@ install(CODE [[
         set(_rename "${_name}.dist")
       endif()
     endif()
-    # The form CMake's own install scripts use (it supports RENAME, and
-    # prepends DESTDIR itself).
-    file(INSTALL DESTINATION "${_rover_etc}" TYPE FILE RENAME "${_rename}"
-      PERMISSIONS OWNER_READ OWNER_WRITE GROUP_READ WORLD_READ FILES "${_src}")
+    # Copied by hand: file(INSTALL) with an absolute destination prepends
+    # DESTDIR differently across CMake versions.
+    file(MAKE_DIRECTORY "${_rover_etc_dest}")
+    file(COPY_FILE "${_src}" "${_rover_etc_dest}/${_rename}")
+    message(STATUS "Installing: ${_rover_etc_dest}/${_rename}")
   endforeach()
 ]])

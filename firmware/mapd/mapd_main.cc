@@ -13,6 +13,7 @@
 
 #include "core/ipc/iceoryx_transport.h"
 #include "firmware/mapd/mapd.h"
+#include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/health/systemd_notifier.h"
 
 namespace {
@@ -32,6 +33,10 @@ int main(int argc, char** argv) {
   rover::mapd::MapdOptions options;
   std::string runtime_name = "mapd";
   double roudi_wait_s = 5.0;
+  std::string config;
+  app.add_option("--config", config,
+                 "board profile (YAML, e.g. /etc/rover/board.yaml): its mapd and ipc sections set "
+                 "the submap limits and the RouDi wait; options given here win");
   app.add_option("--runtime-name", runtime_name, "name registered with RouDi")
       ->capture_default_str();
   app.add_option("--submap-distance-m", options.trigger.max_distance_m,
@@ -43,6 +48,21 @@ int main(int argc, char** argv) {
   app.add_option("--roudi-wait-s", roudi_wait_s, "how long to wait for RouDi")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (!config.empty()) {
+    try {
+      const auto board = rover::runtime::BoardConfig::LoadFile(config);
+      if (app.get_option("--submap-distance-m")->count() == 0) {
+        options.trigger.max_distance_m = board.mapd.submap_max_distance_m;
+      }
+      if (app.get_option("--submap-sigma-m")->count() == 0) {
+        options.trigger.max_position_sigma_m = board.mapd.submap_max_position_sigma_m;
+      }
+      if (app.get_option("--roudi-wait-s")->count() == 0) roudi_wait_s = board.ipc.roudi_wait_s;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "mapd: %s\n", e.what());
+      return 78;  // EX_CONFIG: systemd does not restart a bad configuration
+    }
+  }
   std::signal(SIGTERM, OnSignal);
   std::signal(SIGINT, OnSignal);
   try {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/ipc/iceoryx_transport.h"
+#include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/process/child_process.h"
 
 namespace {
@@ -89,11 +90,22 @@ int main(int argc, char** argv) {
   app.add_option("--run-dir", run_dir, "pid files and RouDi's log")->capture_default_str();
   app.add_option("--restart-backoff-s", restart_backoff_s, "wait before restarting mapd")
       ->capture_default_str();
+  std::string config;
+  app.add_option("--config", config,
+                 "board profile for mapd and roverd-sim (and mapd's restart back-off)");
   app.add_option("roverd_args", roverd_args, "arguments for roverd-sim (after --)");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGTERM, OnSignal);
   std::signal(SIGINT, OnSignal);
   try {
+    if (!config.empty()) {
+      const auto board = rover::runtime::BoardConfig::LoadFile(config);
+      if (app.get_option("--restart-backoff-s")->count() == 0) {
+        restart_backoff_s = board.mapd.restart_backoff_s;
+      }
+      mapd_args.insert(mapd_args.begin(), {"--config", config});
+      roverd_args.insert(roverd_args.begin(), {"--config", config});
+    }
     fs::create_directories(run_dir);
     std::optional<ChildProcess> roudi = StartRouDi(roudi_config, run_dir);
     std::vector<std::string> mapd_argv = {mapd};

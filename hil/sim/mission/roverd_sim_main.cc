@@ -34,13 +34,31 @@ int main(int argc, char** argv) {
   app.add_option("--ipc", options.ipc_runtime_name,
                  "talk to mapd over iceoryx under this runtime name (RouDi must run; "
                  "rover-launch starts it)");
-  std::string images = "thumbnails";
+  std::string config;
+  app.add_option("--config", config,
+                 "board profile (YAML, e.g. firmware/config/sim.yaml): thread scheduling, health, "
+                 "images, log service; its log folder is the default for --out");
+  std::string images;
   app.add_option("--images", images,
-                 "camera images in the log: none, thumbnails (cam0, ~188 px wide, 1 Hz) or full")
-      ->check(CLI::IsMember({"none", "thumbnails", "full"}))
-      ->capture_default_str();
+                 "camera images in the log: none, thumbnails (cam0, ~188 px wide, 1 Hz; the "
+                 "default) or full; overrides the board profile")
+      ->check(CLI::IsMember({"none", "thumbnails", "full"}));
   CLI11_PARSE(app, argc, argv);
-  options.images.mode = rover::roverd::ParseImageLogMode(images);
+  try {
+    if (!config.empty()) {
+      options.board = rover::runtime::BoardConfig::LoadFile(config);
+      const auto& log = options.board->log;
+      options.images.mode =
+          rover::roverd::ParseImageLogMode(std::string(rover::runtime::LogImagesName(log.images)));
+      options.images.thumbnail_width_px = log.thumbnail_width_px;
+      options.images.thumbnail_rate_hz = log.thumbnail_rate_hz;
+      if (app.get_option("--out")->count() == 0) options.out_dir = log.folder;
+    }
+    if (!images.empty()) options.images.mode = rover::roverd::ParseImageLogMode(images);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "roverd-sim: %s\n", e.what());
+    return 78;  // EX_CONFIG: systemd does not restart a bad configuration
+  }
   options.lockstep = !realtime;
   const bool tty = isatty(STDERR_FILENO) != 0;
   options.status = [tty](const std::string& line) {

@@ -12,6 +12,7 @@
 #include "core/ipc/iceoryx_transport.h"
 #include "core/log/flight/flight_log.h"
 #include "drivers/replay/euroc_replay.h"
+#include "firmware/runtime/log_service/log_service.h"
 #include "firmware/runtime/rt/rt_setup.h"
 #include "firmware/runtime/rt/rt_thread.h"
 #include "hil/sim/dataset/dataset_generator.h"
@@ -135,6 +136,18 @@ std::string Fixed(double v, int digits) {
 
 }  // namespace
 
+// The board profile's scheduling and health settings (the IMU thread's own
+// options are applied where RunMission starts it).
+void ApplyBoard(const runtime::BoardConfig& board, roverd::RoverdOptions* rover) {
+  rover->camera_thread = board.threads.camera;
+  rover->can_thread = board.threads.can;
+  rover->vo_thread = board.threads.vo;
+  rover->health.period_s = board.health.period_s;
+  rover->health.stale_after_s = board.health.stale_after_s;
+  rover->health.rate_warn_fraction = board.health.rate_warn_fraction;
+  rover->health.watchdog = board.health.watchdog;
+}
+
 MissionResult RunMission(const MissionOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   MissionResult result;
@@ -148,7 +161,7 @@ MissionResult RunMission(const MissionOptions& options) {
   result.sim_duration_s = duration_s;
   StereoRenderer renderer(world, scenario.camera);  // slow: before the clock starts
   renderer.ReleaseThread();                         // it renders on roverd's camera thread
-  if (!options.lockstep) {
+  if (!options.lockstep && (!options.board || options.board->realtime.lock_memory)) {
     // Real time: memory locked before the sensors start (locking takes a
     // while); without the privileges it degrades, and says so once.
     const runtime::RtSetupReport setup = runtime::RtSetup::Apply({.program_name = "roverd-sim"});
@@ -186,6 +199,7 @@ MissionResult RunMission(const MissionOptions& options) {
   head.vo.checks.nominal_rate_hz = scenario.camera.rate_hz;
   rover.camera = head;
   rover.lockstep = options.lockstep;
+  if (options.board) ApplyBoard(*options.board, &rover);
 
   fs::create_directories(options.out_dir);
   result.log_path =
@@ -203,6 +217,16 @@ MissionResult RunMission(const MissionOptions& options) {
       flight_log.AddChannel<log::diagnostic_msgs::DiagnosticArray, 16384, 64>("/diagnostics");
   flight_log.Start();
 
+  // The board's HTTP log service, if its profile has one: serves this
+  // mission's log folder (a log still being written up to its last chunk).
+  std::optional<runtime::LogService> log_service;
+  if (options.board && options.board->log_service) {
+    runtime::LogServiceOptions service = *options.board->log_service;
+    service.log_folder = options.out_dir;
+    log_service.emplace(service);
+    log_service->Start();
+    result.log_service_port = log_service->port();
+  }
   LatestState latest;
   SimCameraTrigger trigger(triggers, clock, start, lost_at(options.camera_loss_at_s));
   std::unique_ptr<ipc::IceoryxTransport> transport;
@@ -249,7 +273,9 @@ MissionResult RunMission(const MissionOptions& options) {
     result.stats = roverd.Run();
   } else {
     // Real time: the IMU loop gets its SCHED_FIFO thread (DESIGN.md).
-    runtime::RtThread imu_thread({"imu", 80, 0, {}, 256 * 1024},
+    runtime::RtThreadOptions imu_thread_options{"imu", 80, 0, {}, 256 * 1024};
+    if (options.board) imu_thread_options = options.board->threads.imu;
+    runtime::RtThread imu_thread(imu_thread_options,
                                  [&](std::stop_token) { result.stats = roverd.Run(); });
     imu_thread.Join();
     result.stats.thread_reports.insert(result.stats.thread_reports.begin(),
@@ -334,6 +360,9 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
         << " % of distance), against the simulator's ground truth\n";
   } else {
     out << "  error   the filter never initialised\n";
+  }
+  if (r.log_service_port != 0) {
+    out << "  service the board's log service listens on port " << r.log_service_port << "\n";
   }
   out << "  log     " << r.log_path << " (" << r.log_records << " records, " << r.log_drops
       << " dropped); replay it with `rover replay " << r.log_path << "`\n";

@@ -9,7 +9,10 @@
 #include <functional>
 #include <string>
 
+#include <optional>
+
 #include "firmware/roverd/roverd.h"
+#include "firmware/runtime/board/board_config.h"
 
 namespace rover::sim {
 
@@ -31,6 +34,9 @@ struct MissionOptions {
   double can_loss_at_s = 0.0;
   /// Camera images in the log (thumbnails by default).
   roverd::ImageLogOptions images;
+  /// The board profile (firmware/config/sim.yaml): thread scheduling,
+  /// health, images, the log service. Absent: the built-in defaults.
+  std::optional<runtime::BoardConfig> board;
   /// Called about once per second of wall time with one status line.
   std::function<void(const std::string& line)> status;
 };
@@ -50,6 +56,7 @@ struct MissionResult {
   bool ipc = false;
   roverd::MapdLinkStats mapd_link;
   uint64_t frame_switches = 0;
+  int log_service_port = 0;  ///< 0: no log service
   uint64_t log_records = 0;
   uint64_t log_drops = 0;
 };
