@@ -86,9 +86,16 @@ TEST(MapdCrashTest, KillingMapdLeavesNoGapInTheImuLoopAndMapdResumesWithANewSubm
        .output_file = output.string()});
   const pid_t first = WaitForPid(run_dir / "mapd.pid", 0, Duration::Seconds(30));
   ASSERT_GT(first, 0) << ReadFile(output);
-  // Let the mission run (the renderer's set-up and the filter's standstill
-  // initialisation take a few seconds), then kill mapd without warning.
-  std::this_thread::sleep_for(std::chrono::seconds(7));
+  // Let the mission run until the first mapd has its submap (the status
+  // line shows the filter in frame 1: the renderer's set-up and the
+  // filter's standstill initialisation take a few seconds, more on a loaded
+  // machine), then kill mapd without warning.
+  const Time give_up = Time::Now() + Duration::Seconds(90);
+  while (ReadFile(output).find("mapd up, frame 1") == std::string::npos) {
+    ASSERT_LT(Time::Now(), give_up) << "no frame switch yet\n" << ReadFile(output);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(1));
   const Time killed_at = Time::Now();
   ASSERT_EQ(::kill(first, SIGKILL), 0);
   const pid_t second = WaitForPid(run_dir / "mapd.pid", first, Duration::Seconds(10));
