@@ -10,12 +10,16 @@ namespace {
 void Nap() { std::this_thread::sleep_for(std::chrono::milliseconds(1)); }
 
 // In lockstep the sensor stamps are simulated time and the monitors run on
-// it too (see MonitorClock): rates, gaps and staleness in simulated seconds.
-// Latency against the wall clock would be meaningless there.
+// it too (see MonitorClock): gaps and staleness in simulated seconds.
+// Latency against the wall clock would be meaningless there, and so would
+// the rate check: the gate lets the camera and CAN threads run up to
+// lockstep_lead ahead of the IMU, whose time the snapshots are taken at, so
+// one interval's count is skewed by up to that lead.
 runtime::SensorMonitorOptions MonitorOptions(const RoverdOptions& options) {
   options.health.Validate();
   runtime::SensorMonitorOptions m = options.health.sensor_monitor_options();
   m.measure_latency = !options.lockstep;
+  if (options.lockstep) m.rate_warn_fraction = 0.0;
   return m;
 }
 
