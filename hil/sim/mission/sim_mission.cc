@@ -9,12 +9,8 @@
 #include <ostream>
 #include <thread>
 
-#include "core/ipc/iceoryx_transport.h"
-#include "core/log/flight/flight_log.h"
 #include "drivers/replay/euroc_replay.h"
-#include "firmware/runtime/log_service/log_service.h"
-#include "firmware/runtime/rt/rt_setup.h"
-#include "firmware/runtime/rt/rt_thread.h"
+#include "firmware/roverd/roverd_process.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/estimator_feed/filter_run.h"
 #include "hil/sim/live/sim_camera_trigger.h"
@@ -161,12 +157,6 @@ MissionResult RunMission(const MissionOptions& options) {
   result.sim_duration_s = duration_s;
   StereoRenderer renderer(world, scenario.camera);  // slow: before the clock starts
   renderer.ReleaseThread();                         // it renders on roverd's camera thread
-  if (!options.lockstep && (!options.board || options.board->realtime.lock_memory)) {
-    // Real time: memory locked before the sensors start (locking takes a
-    // while); without the privileges it degrades, and says so once.
-    const runtime::RtSetupReport setup = runtime::RtSetup::Apply({.program_name = "roverd-sim"});
-    if (!setup.warning.empty()) std::fprintf(stderr, "%s\n", setup.warning.c_str());
-  }
   // Lockstep uses the datasets' fixed time origin; in real time the sensors
   // stamp on CLOCK_MONOTONIC, as real ones do, from now on.
   const Time start = options.lockstep ? kDatasetStartTime : Time::Now();
@@ -201,48 +191,31 @@ MissionResult RunMission(const MissionOptions& options) {
   rover.lockstep = options.lockstep;
   if (options.board) ApplyBoard(*options.board, &rover);
 
-  fs::create_directories(options.out_dir);
   result.log_path =
       (fs::path(options.out_dir) / ("mission-" + options.scenario + ".mcap")).string();
-  fs::remove(result.log_path);
-  log::FlightLog flight_log;
-  flight_log.Open(result.log_path);
-  flight_log.WriteMetadata("mission", {{"scenario", options.scenario},
-                                       {"seed", std::to_string(options.seed)},
-                                       {"lockstep", options.lockstep ? "true" : "false"}});
-  const roverd::EstimatorLogChannels channels =
-      roverd::EstimatorLogChannels::Add(&flight_log, rover.estimator);
-  roverd::ImageLogger image_logger(options.images, &flight_log);
-  roverd::DiagnosticsChannel* diagnostics =
-      flight_log.AddChannel<log::diagnostic_msgs::DiagnosticArray, 16384, 64>("/diagnostics");
-  flight_log.Start();
-
-  // The board's HTTP log service, if its profile has one: serves this
-  // mission's log folder (a log still being written up to its last chunk).
-  std::optional<runtime::LogService> log_service;
-  if (options.board && options.board->log_service) {
-    runtime::LogServiceOptions service = *options.board->log_service;
-    service.log_folder = options.out_dir;
-    log_service.emplace(service);
-    log_service->Start();
-    result.log_service_port = log_service->port();
+  roverd::RoverdProcessOptions process_options;
+  process_options.log_path = result.log_path;
+  process_options.metadata["mission"] = {{"scenario", options.scenario},
+                                         {"seed", std::to_string(options.seed)},
+                                         {"lockstep", options.lockstep ? "true" : "false"}};
+  process_options.ipc_runtime_name = options.ipc_runtime_name;
+  process_options.images = options.images;
+  process_options.program_name = "roverd-sim";
+  if (options.board) {
+    process_options.lock_memory = options.board->realtime.lock_memory;
+    process_options.imu_thread = options.board->threads.imu;
+    process_options.roudi_wait = Duration::FromSeconds(options.board->ipc.roudi_wait_s);
+    if (options.board->log_service) {
+      // The board's HTTP log service serves this mission's log folder.
+      process_options.log_service = *options.board->log_service;
+      process_options.log_service->log_folder = options.out_dir;
+    }
   }
   LatestState latest;
   SimCameraTrigger trigger(triggers, clock, start, lost_at(options.camera_loss_at_s));
-  std::unique_ptr<ipc::IceoryxTransport> transport;
-  std::optional<roverd::MapdLink> mapd_link;
-  if (!options.ipc_runtime_name.empty()) {
-    std::string error;
-    transport = ipc::IceoryxTransport::Create({.runtime_name = options.ipc_runtime_name}, &error);
-    if (transport == nullptr) throw std::runtime_error(error);
-    mapd_link.emplace(transport.get());
-    result.ipc = true;
-  }
-  roverd::Roverd roverd(rover, {&imu, &camera, &trigger, &can}, channels,
-                        {.listener = &latest,
-                         .mapd_link = mapd_link ? &*mapd_link : nullptr,
-                         .images = &image_logger,
-                         .diagnostics = diagnostics});
+  roverd::RoverdProcess process(rover, {&imu, &camera, &trigger, &can}, process_options, &latest);
+  const roverd::MapdLink* mapd_link = process.mapd_link();
+  result.ipc = mapd_link != nullptr;
   std::atomic<bool> done{false};
   std::thread status([&] {
     while (!done.load()) {
@@ -251,7 +224,7 @@ MissionResult RunMission(const MissionOptions& options) {
       }
       if (done.load() || !options.status) continue;
       const LatestState::Snapshot s = latest.Read();
-      const roverd::EstimatorLoopStats loop = roverd.loop().stats();
+      const roverd::EstimatorLoopStats loop = process.roverd().loop().stats();
       std::string line = "t " + Fixed((s.stamp - start).ToSeconds(), 1) + "/" +
                          Fixed(duration_s, 0) + " s  inputs " + std::to_string(loop.inputs);
       if (s.initialised && latest.init_stamp_ns()) {
@@ -269,27 +242,22 @@ MissionResult RunMission(const MissionOptions& options) {
       options.status(line);
     }
   });
-  if (options.lockstep) {
-    result.stats = roverd.Run();
-  } else {
-    // Real time: the IMU loop gets its SCHED_FIFO thread (DESIGN.md).
-    runtime::RtThreadOptions imu_thread_options{"imu", 80, 0, {}, 256 * 1024};
-    if (options.board) imu_thread_options = options.board->threads.imu;
-    runtime::RtThread imu_thread(imu_thread_options,
-                                 [&](std::stop_token) { result.stats = roverd.Run(); });
-    imu_thread.Join();
-    result.stats.thread_reports.insert(result.stats.thread_reports.begin(),
-                                       imu_thread.report().Describe());
+  roverd::RoverdProcessResult run;
+  try {
+    run = process.Run();
+  } catch (...) {
+    done.store(true);
+    status.join();
+    throw;
   }
   done.store(true);
   status.join();
-  if (mapd_link) result.mapd_link = mapd_link->stats();
+  result.stats = run.stats;
+  if (run.mapd_link) result.mapd_link = *run.mapd_link;
+  result.log_service_port = run.log_service_port;
   result.frame_switches = latest.frame_switches();
-  flight_log.Stop();
-  const log::FlightLogStats log_stats = flight_log.stats();
-  result.log_records = log_stats.written;
-  result.log_drops = log_stats.dropped;
-  if (!log_stats.error.empty()) throw std::runtime_error(result.log_path + ": " + log_stats.error);
+  result.log_records = run.log.written;
+  result.log_drops = run.log.dropped;
 
   const LatestState::Snapshot last = latest.Read();
   if (last.initialised && latest.init_stamp_ns()) {
