@@ -251,7 +251,11 @@ BoardConfig BoardConfig::Load(const ConfigNode& root) {
   }
   if (c.board.profile == BoardProfile::kReplay) {
     const ConfigNode replay = root.Child("replay");
-    c.replay = BoardReplayOptions{replay.Get<std::string>("dataset")};
+    c.replay = BoardReplayOptions{};
+    c.replay->dataset = replay.Get<std::string>("dataset");
+    c.replay->estimator_config = replay.Get<std::string>("estimator_config", "");
+    c.replay->vo_config = replay.Get<std::string>("vo_config", "");
+    c.replay->lockstep = replay.Get<bool>("lockstep", false);
   }
 
   if (root.Has("threads")) {

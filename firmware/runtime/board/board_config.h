@@ -73,6 +73,14 @@ struct BoardIdentity {
 struct BoardReplayOptions {
   /// Folder of a EuRoC-layout dataset (holds mav0/).
   std::string dataset;
+  /// EskfOptions YAML (e.g. host/eval/config/euroc_mav.yaml); empty: the
+  /// defaults with the dataset's IMU noise figures.
+  std::string estimator_config{};
+  /// StereoOdometryOptions YAML; empty: the defaults at the dataset's rate.
+  std::string vo_config{};
+  /// Hand the data out as fast as the threads take it instead of at its
+  /// recorded pace (bench and CI runs).
+  bool lockstep = false;
 };
 
 /// `threads:` scheduling of every firmware thread (see DESIGN.md).

@@ -33,6 +33,10 @@ Time ImuStamp(int i) { return kStart + Duration::FromSeconds(i / kImuRateHz); }
 // until the IMU has reached its stamp, so every thread has work in flight at
 // the same time (and the filter sees inputs about when they are due).
 std::atomic<int64_t> g_imu_ns{0};
+// And the IMU does not run more than a frame period ahead of the camera, so
+// a slow camera thread (2 MB copies per frame under TSan) still delivers
+// every frame before the IMU stream, and with it the run, ends.
+std::atomic<int64_t> g_camera_ns{0};
 bool WaitForImu(Time stamp, Duration timeout) {
   const Time until = Time::Now() + timeout;
   while (g_imu_ns.load() < stamp.nanoseconds()) {
@@ -47,6 +51,9 @@ class ScriptedImu final : public drivers::ImuDriver {
   drivers::ReadStatus Read(drivers::ImuSample* s, Duration) override {
     if (next_ >= kImuSamples) return drivers::ReadStatus::kEndOfStream;
     if (next_ % 4 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    while (g_camera_ns.load() < (ImuStamp(next_) - Duration::Milliseconds(150)).nanoseconds()) {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
     s->stamp = ImuStamp(next_);
     s->sequence = static_cast<uint64_t>(next_);
     s->angular_velocity_rad_s.setZero();
@@ -76,6 +83,7 @@ class ScriptedCamera final : public drivers::StereoCameraDriver {
     f->cam0 = view;
     f->cam1 = view;  // zero disparity: points at infinity, which the VO must survive
     ++next_;
+    g_camera_ns.store(next_ >= 60 ? INT64_MAX : stamp.nanoseconds());
     return drivers::ReadStatus::kOk;
   }
   void Release(const drivers::StereoFrame&) override {}
@@ -122,6 +130,7 @@ estimator::vo::CameraModel Camera(double x_m) {
 TEST(RoverdThreadsTest, AllThreadsHandOverWithoutLossInRealTimeMode) {
   cv::setNumThreads(1);
   g_imu_ns.store(0);
+  g_camera_ns.store((kStart - Duration::Milliseconds(100)).nanoseconds());
   RoverdOptions options;
   options.lockstep = false;
   options.camera = CameraSetup{Camera(0.0), Camera(0.11), {}};
