@@ -152,6 +152,25 @@ class Roverd {
   void Stop();
 
   const EstimatorLoop& loop() const { return loop_; }
+  /// Counters while running, for status lines. Any thread.
+  struct LiveCounters {
+    uint64_t imu_samples = 0;
+    uint64_t frames = 0;
+    uint64_t frame_drops = 0;
+    uint64_t wheel_readings = 0;
+    uint64_t vo_measurements = 0;
+  };
+  LiveCounters live() const {
+    return {imu_steps_.load(std::memory_order_relaxed), frames_.load(std::memory_order_relaxed),
+            frame_drops_.load(std::memory_order_relaxed),
+            wheel_readings_.load(std::memory_order_relaxed),
+            vo_measurements_.load(std::memory_order_relaxed)};
+  }
+  /// Stamp of the newest IMU sample the loop has processed (zero before the
+  /// first). Any thread.
+  Time latest_imu_stamp() const {
+    return Time::FromNanoseconds(latest_imu_ns_.load(std::memory_order_relaxed));
+  }
 
  private:
   struct FrameSlot {

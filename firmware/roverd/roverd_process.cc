@@ -9,9 +9,23 @@
 
 namespace rover::roverd {
 
+log::FlightLogOptions RoverdProcess::LogOptions(bool lockstep, const RoverdProcess* self) {
+  log::FlightLogOptions o;
+  // In lockstep the data carry simulated time; the log's own health records
+  // follow it (the writer thread starts after roverd_ exists).
+  if (lockstep) {
+    o.record_clock = [self] {
+      return self->roverd_ ? self->roverd_->latest_imu_stamp() : Time::Zero();
+    };
+  }
+  return o;
+}
+
 RoverdProcess::RoverdProcess(const RoverdOptions& roverd_options, const RoverdDrivers& drivers,
                              const RoverdProcessOptions& options, EstimatorListener* listener)
-    : options_(options), lockstep_(roverd_options.lockstep) {
+    : options_(options),
+      lockstep_(roverd_options.lockstep),
+      flight_log_(LogOptions(roverd_options.lockstep, this)) {
   if (!lockstep_ && options_.lock_memory) {
     // Before the sensors start (locking takes a while); without the
     // privileges it degrades, and says so once.
@@ -52,6 +66,7 @@ RoverdProcess::RoverdProcess(const RoverdOptions& roverd_options, const RoverdDr
 
 RoverdProcess::~RoverdProcess() {
   if (log_service_) log_service_->Stop();
+  flight_log_.Stop();  // its writer reads roverd_ (record_clock): stop it first
 }
 
 RoverdProcessResult RoverdProcess::Run() {

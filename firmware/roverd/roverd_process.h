@@ -74,6 +74,8 @@ class RoverdProcess {
   const MapdLink* mapd_link() const { return mapd_link_ ? &*mapd_link_ : nullptr; }
 
  private:
+  static log::FlightLogOptions LogOptions(bool lockstep, const RoverdProcess* self);
+
   RoverdProcessOptions options_;
   bool lockstep_;
   log::FlightLog flight_log_;

@@ -116,7 +116,9 @@ void FlightLog::FlushChunk() {
   }
 }
 
-void FlightLog::WriteHealth(Time now) {
+void FlightLog::WriteHealth(Time wall_now) {
+  const Time now = options_.record_clock ? options_.record_clock() : wall_now;
+  if (now == Time::Zero()) return;
   health_msg_.header.stamp = ToRosTime(now);
   uint64_t written = 0;
   for (std::size_t i = 0; i < channels_.size(); ++i) {

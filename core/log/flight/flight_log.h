@@ -14,6 +14,7 @@
 
 #include <condition_variable>
 #include <exception>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -33,6 +34,12 @@ struct FlightLogOptions {
   Duration drain_period = Duration::Milliseconds(5);
   Duration health_period = Duration::Seconds(1);
   std::string health_topic = "/rover/log_health";
+  /// Log time of the LogHealth records (called on the writer thread). Empty:
+  /// CLOCK_MONOTONIC. A simulation in lockstep, whose data carry simulated
+  /// time, passes its newest sensor time so that the health records sit
+  /// among the data they describe; a record is skipped while it returns
+  /// Time::Zero() (no data yet).
+  std::function<Time()> record_clock;
 };
 
 /// Totals over all channels, for summaries and tests.

@@ -11,6 +11,7 @@
 
 #include "drivers/replay/euroc_replay.h"
 #include "firmware/roverd/roverd_process.h"
+#include "firmware/roverd/roverd_summary.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/estimator_feed/filter_run.h"
 #include "hil/sim/live/sim_camera_trigger.h"
@@ -218,15 +219,28 @@ MissionResult RunMission(const MissionOptions& options) {
   result.ipc = mapd_link != nullptr;
   std::atomic<bool> done{false};
   std::thread status([&] {
+    // Rates over the last status period, in simulated time.
+    roverd::Roverd::LiveCounters last_counts;
+    Time last_stamp = start;
     while (!done.load()) {
       for (int i = 0; i < 10 && !done.load(); ++i) {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
       }
       if (done.load() || !options.status) continue;
       const LatestState::Snapshot s = latest.Read();
-      const roverd::EstimatorLoopStats loop = process.roverd().loop().stats();
+      const roverd::Roverd::LiveCounters counts = process.roverd().live();
+      const double dt_s = (s.stamp - last_stamp).ToSeconds();
+      const auto rate = [dt_s](uint64_t now_count, uint64_t then_count) {
+        return dt_s > 0.0 ? Fixed(static_cast<double>(now_count - then_count) / dt_s, 0) : "-";
+      };
       std::string line = "t " + Fixed((s.stamp - start).ToSeconds(), 1) + "/" +
-                         Fixed(duration_s, 0) + " s  inputs " + std::to_string(loop.inputs);
+                         Fixed(duration_s, 0) + " s  imu " +
+                         rate(counts.imu_samples, last_counts.imu_samples) + " Hz  cam " +
+                         rate(counts.frames, last_counts.frames) + " Hz  wheels " +
+                         rate(counts.wheel_readings, last_counts.wheel_readings) + " Hz  drops " +
+                         std::to_string(counts.frame_drops);
+      last_counts = counts;
+      last_stamp = s.stamp;
       if (s.initialised && latest.init_stamp_ns()) {
         const Eigen::Vector3d truth = TrueInFrame0(
             trajectory, start, Time::FromNanoseconds(*latest.init_stamp_ns()), s.stamp);
@@ -280,48 +294,9 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
   const roverd::RoverdStats& s = r.stats;
   out << "mission " << r.scenario << ": " << Fixed(r.sim_duration_s, 1) << " s simulated in "
       << Fixed(r.wall_time_s, 1) << " s wall time\n";
-  out << "  IMU     " << s.imu_samples << " samples, " << s.imu_drops << " dropped, "
-      << s.imu_errors << " errors\n";
-  out << "  camera  " << s.frames << " frames, " << s.frame_drops << " dropped; VO "
-      << s.vo_measurements << " relative poses (" << s.vo.keyframes << " keyframes, "
-      << s.vo.restarts << " restarts, " << s.vo.Count(estimator::vo::VoStatus::kTextureless)
-      << " textureless); " << s.images_logged << " images logged (" << s.image_log_drops
-      << " dropped)\n";
-  out << "  CAN     " << s.can.syncs << " SYNC periods, " << s.wheel_readings << " wheel readings, "
-      << s.can.incomplete << " incomplete, " << s.can_errors << " errors\n";
-  std::string reasons;
-  for (int k = 0; k <= static_cast<int>(estimator::RejectReason::kNumerical); ++k) {
-    const auto reason = static_cast<estimator::RejectReason>(k);
-    const uint64_t n = s.filter.Rejected(estimator::InputKind::kRelativePose, reason);
-    if (n == 0) continue;
-    reasons += std::string(reasons.empty() ? " (" : ", ") + estimator::ToString(reason) + " " +
-               std::to_string(n);
-  }
-  if (!reasons.empty()) reasons += ")";
-  out << "  filter  " << s.loop.inputs << " inputs; relative poses accepted "
-      << s.filter.Accepted(estimator::InputKind::kRelativePose) << ", rejected "
-      << s.filter.Rejected(estimator::InputKind::kRelativePose) << reasons
-      << "; wheel speeds accepted " << s.filter.Accepted(estimator::InputKind::kWheelSpeeds)
-      << "; late inputs " << s.loop.late_inputs << ", ring drops " << s.loop.ring_drops << "\n";
-  const auto us = [](int64_t ns) { return Fixed(static_cast<double>(ns) / 1000.0, 1); };
-  out << "  loop    estimator step wall time p50 " << us(s.step_latency.p50_ns) << " us, p99 "
-      << us(s.step_latency.p99_ns) << " us, p99.9 " << us(s.step_latency.p999_ns) << " us, max "
-      << us(s.step_latency.max_ns) << " us\n";
-  if (s.sample_to_estimate.count > 0) {
-    out << "          IMU sample to estimate p50 " << us(s.sample_to_estimate.p50_ns) << " us, p99 "
-        << us(s.sample_to_estimate.p99_ns) << " us, p99.9 " << us(s.sample_to_estimate.p999_ns)
-        << " us, max " << us(s.sample_to_estimate.max_ns) << " us\n";
-  }
-  for (const std::string& t : s.thread_reports) out << "  thread  " << t << "\n";
-  out << "  health  " << s.health_reports
-      << " reports to /diagnostics; last: " << (s.health.empty() ? "(none)" : s.health) << "\n";
-  if (r.ipc) {
-    const roverd::MapdLinkStats& m = r.mapd_link;
-    out << "  mapd    " << m.poses_published << " estimates and " << m.frames_published
-        << " stereo pairs published (" << m.publish_drops << " dropped); " << m.requests
-        << " frame-switch requests (" << m.requests_refused << " refused), " << r.frame_switches
-        << " frame switches\n";
-  }
+  roverd::PrintRoverdStats(
+      s, r.ipc ? std::optional<roverd::MapdLinkStats>(r.mapd_link) : std::nullopt, out);
+  if (r.ipc) out << "          " << r.frame_switches << " frame switches\n";
   if (r.filter_initialised) {
     out << "  error   " << Fixed(r.filter_final_error_m, 3) << " m after " << Fixed(r.distance_m, 1)
         << " m (" << Fixed(r.filter_final_error_pct, 3)
