@@ -1,0 +1,60 @@
+#ifndef ROVER_MAPPING_DEPTH_DISPARITY_ESTIMATOR_H_
+#define ROVER_MAPPING_DEPTH_DISPARITY_ESTIMATOR_H_
+
+// Dense disparity from a rectified stereo pair with OpenCV's semi-global
+// block matching (the thesis ran SGM on an FPGA at 1024x508 and 14.6 Hz;
+// mapd runs StereoSGBM on a CPU core). The output is OpenCV's fixed point:
+// CV_16S, 16 per pixel of disparity, with (min_disparity - 1) * 16 marking
+// pixels without a match; DepthImage turns it into points.
+
+#include <string>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include "core/config/config.h"
+
+namespace rover::mapping {
+
+struct DisparityOptions {
+  int min_disparity_px = 0;
+  /// Search range; a positive multiple of 16. 64 px at f = 460 px, b = 0.11 m
+  /// reaches down to 0.8 m.
+  int num_disparities_px = 64;
+  int block_size_px = 5;  ///< odd, 1..11
+  /// Smoothness penalties; 0 means OpenCV's usual 8 and 32 * block_size^2.
+  int p1 = 0;
+  int p2 = 0;
+  int uniqueness_ratio_pct = 10;
+  int speckle_window_px = 100;  ///< 0 disables speckle filtering
+  int speckle_range_px = 2;
+  int max_left_right_diff_px = 1;  ///< left-right consistency; -1 disables it
+  /// "sgbm" (5 directions), "sgbm_3way" (faster) or "hh" (8 directions).
+  std::string mode = "sgbm_3way";
+
+  /// Absent keys keep their defaults; unknown keys are the caller's to check.
+  static DisparityOptions Load(const ConfigNode& node);
+  /// Throws std::invalid_argument "DisparityOptions.<key>: expected ..., found ...".
+  void Validate() const;
+};
+
+class DisparityEstimator {
+ public:
+  explicit DisparityEstimator(const DisparityOptions& options);
+
+  /// Disparity of the rectified mono8 pair (same size). Throws
+  /// std::invalid_argument naming what is wrong with the images.
+  void Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* disparity_q4) const;
+
+  const DisparityOptions& options() const { return options_; }
+  /// The fixed-point value OpenCV writes for "no match".
+  int InvalidValue() const { return (options_.min_disparity_px - 1) * 16; }
+
+ private:
+  DisparityOptions options_;
+  cv::Ptr<cv::StereoSGBM> sgbm_;
+};
+
+}  // namespace rover::mapping
+
+#endif  // ROVER_MAPPING_DEPTH_DISPARITY_ESTIMATOR_H_

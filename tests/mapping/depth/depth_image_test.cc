@@ -1,0 +1,94 @@
+// Disparity to depth: SGBM on a synthetic textured plane recovers its
+// depth; invalid, infinitely far, too uncertain and valid pixels stay apart.
+
+#include "mapping/depth/depth_image.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "mapping/depth/disparity_estimator.h"
+
+namespace rover::mapping {
+namespace {
+
+RectifiedStereo Head(int w, int h) {
+  RectifiedStereo s;
+  s.width_px = w;
+  s.height_px = h;
+  s.focal_px = 400.0;
+  s.cx_px = w / 2.0;
+  s.cy_px = h / 2.0;
+  s.baseline_m = 0.1;
+  return s;
+}
+
+TEST(DepthImageTest, ClassifiesEachKindOfPixel) {
+  const RectifiedStereo s = Head(4, 1);
+  const StereoErrorModel model(s, 0.5);
+  cv::Mat disparity(1, 4, CV_16SC1);
+  disparity.at<int16_t>(0, 0) = -16;      // no match
+  disparity.at<int16_t>(0, 1) = 0;        // zero disparity: beyond range
+  disparity.at<int16_t>(0, 2) = 16 * 2;   // 2 px: z = 20 m, sigma_z = 1.4 m
+  disparity.at<int16_t>(0, 3) = 16 * 40;  // 40 px: z = 1 m, sigma_z = 1.8 cm
+  const DepthImage depth = DepthImage::FromDisparity(disparity, model, {});
+  EXPECT_EQ(depth.state(0, 0), DepthState::kInvalid);
+  EXPECT_EQ(depth.state(1, 0), DepthState::kInfinite);
+  EXPECT_EQ(depth.state(2, 0), DepthState::kUncertain);
+  EXPECT_EQ(depth.state(3, 0), DepthState::kValid);
+  EXPECT_NEAR(depth.point(3, 0).z(), 1.0f, 1e-6f);
+  EXPECT_NEAR(depth.depth_sigma(3, 0), 0.5 * 1.0 / 40.0 * std::sqrt(2.0), 1e-6);
+  EXPECT_EQ(depth.counts().invalid, 1);
+  EXPECT_EQ(depth.counts().infinite, 1);
+  EXPECT_EQ(depth.counts().uncertain, 1);
+  EXPECT_EQ(depth.counts().valid, 1);
+  EXPECT_THROW(DepthImage::FromDisparity(cv::Mat(2, 4, CV_16SC1), model, {}),
+               std::invalid_argument);
+}
+
+TEST(DepthImageTest, SgbmRecoversATexturedPlane) {
+  const int w = 320, h = 240;
+  const double disparity_px = 20.0;  // z = 400 * 0.1 / 20 = 2 m
+  cv::Mat texture(h, w + 64, CV_8UC1);
+  cv::RNG rng(3);
+  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
+  // A fronto-parallel plane: a texture column c is at u_l = c - 32 in the
+  // left image and at u_r = u_l - d in the right one.
+  const cv::Mat left = texture(cv::Rect(32, 0, w, h)).clone();
+  const cv::Mat right = texture(cv::Rect(32 + static_cast<int>(disparity_px), 0, w, h)).clone();
+  const DisparityEstimator sgbm({});
+  cv::Mat disparity;
+  sgbm.Compute(left, right, &disparity);
+  const RectifiedStereo s = Head(w, h);
+  const DepthImage depth = DepthImage::FromDisparity(disparity, StereoErrorModel(s), {});
+  int good = 0, inside = 0;
+  for (int v = 10; v < h - 10; ++v) {
+    for (int u = 80; u < w - 10; ++u) {  // left border: no match by construction
+      ++inside;
+      if (depth.state(u, v) == DepthState::kValid &&
+          std::abs(depth.point(u, v).z() - 2.0f) < 0.02f) {
+        ++good;
+      }
+    }
+  }
+  EXPECT_GT(static_cast<double>(good) / inside, 0.95) << good << " of " << inside;
+  EXPECT_THROW(sgbm.Compute(left, cv::Mat(), &disparity), std::invalid_argument);
+}
+
+TEST(DisparityOptionsTest, RejectsBadValuesNamingThem) {
+  DisparityOptions o;
+  o.num_disparities_px = 60;
+  try {
+    o.Validate();
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("num_disparities_px"), std::string::npos);
+  }
+  o = {};
+  o.mode = "fast";
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rover::mapping
