@@ -31,6 +31,7 @@ DepthImage DepthImage::FromDisparity(const cv::Mat& disparity_q4, const StereoEr
   DepthImage out;
   out.width_ = s.width_px;
   out.height_ = s.height_px;
+  out.stereo_ = s;
   const std::size_t n =
       static_cast<std::size_t>(s.width_px) * static_cast<std::size_t>(s.height_px);
   out.states_.assign(n, DepthState::kInvalid);

@@ -63,6 +63,12 @@ class DepthImage {
   /// sigma_z at (u, v) (0 where there is no point).
   float depth_sigma(int u, int v) const { return depth_sigma_[Index(u, v)]; }
   const DepthImageCounts& counts() const { return counts_; }
+  /// The geometry it was made with.
+  const RectifiedStereo& stereo() const { return stereo_; }
+  /// Direction (not normalised, z = 1) of the ray through pixel (u, v).
+  Eigen::Vector3d Ray(int u, int v) const {
+    return {(u - stereo_.cx_px) / stereo_.focal_px, (v - stereo_.cy_px) / stereo_.focal_px, 1.0};
+  }
 
  private:
   std::size_t Index(int u, int v) const {
@@ -72,6 +78,7 @@ class DepthImage {
 
   int width_ = 0;
   int height_ = 0;
+  RectifiedStereo stereo_;
   std::vector<DepthState> states_;
   std::vector<Eigen::Vector3f> points_;
   std::vector<float> depth_sigma_;
