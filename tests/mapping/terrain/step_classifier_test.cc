@@ -74,3 +74,46 @@ TEST(StepClassifierTest, RejectsBadOptions) {
 
 }  // namespace
 }  // namespace rover::mapping
+
+#include "mapping/terrain/traversability_grid.h"
+
+namespace rover::mapping {
+namespace {
+
+StepGrid OneCell(double x, double y, float value) {
+  StepGrid g;
+  g.cols = g.rows = 1;
+  g.resolution_m = 0.05;
+  g.origin_xy = {x, y};
+  g.traversability = {value};
+  return g;
+}
+
+TEST(TraversabilityGridTest, LowPassFiltersObservationsAndScrollsWithTheRover) {
+  TraversabilityGrid grid({.half_extent_m = 1.0, .alpha = 0.5});
+  EXPECT_LT(grid.ValueAt({0.52, 0.02}), 0.0f) << "unknown before any observation";
+  grid.Add(OneCell(0.50, 0.0, 2.0f), {});
+  EXPECT_FLOAT_EQ(grid.ValueAt({0.52, 0.02}), 2.0f) << "the first observation is taken as is";
+  grid.Add(OneCell(0.50, 0.0, 0.0f), {});
+  EXPECT_FLOAT_EQ(grid.ValueAt({0.52, 0.02}), 1.0f) << "then blended with alpha 0.5";
+  // The rover moves 0.6 m along x: the cell stays where it is in the world.
+  grid.Recentre({0.6, 0.0});
+  EXPECT_FLOAT_EQ(grid.ValueAt({0.52, 0.02}), 1.0f);
+  // ... and 3 m further it has scrolled off (the grid spans +-1 m).
+  grid.Recentre({3.6, 0.0});
+  EXPECT_LT(grid.ValueAt({0.52, 0.02}), 0.0f);
+  grid.Recentre({0.6, 0.0});
+  EXPECT_LT(grid.ValueAt({0.52, 0.02}), 0.0f) << "forgotten, not kept";
+}
+
+TEST(TraversabilityGridTest, NegativeEdgesAreUntraversable) {
+  TraversabilityGrid grid({});
+  NegativeEdge edge;
+  edge.q_gravity = {1.0, -0.3, 0.0};
+  grid.Add(OneCell(1.0, -0.3, 0.2f), {edge});
+  EXPECT_GT(grid.ValueAt({1.01, -0.29}), 1.0f);
+  EXPECT_THROW(TraversabilityGrid({.alpha = 0.0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rover::mapping
