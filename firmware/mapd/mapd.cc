@@ -91,24 +91,39 @@ void Mapd::OnFrameSwitch(const topics::FrameSwitchMsg& record) {
     return;
   }
   ++stats_.frame_switches;
+  // Topics are not ordered against each other: the new frame's first
+  // estimates may have arrived (and opened its submap) before this record.
+  if (!submaps_.empty() && submaps_.back().frame_id == record.new_frame_id &&
+      !submaps_.back().origin) {
+    submaps_.back().origin = record;
+    return;
+  }
   pending_origin_ = record;
 }
 
-SubmapRecord& Mapd::Current(uint32_t frame_id, Time stamp) {
-  if (submaps_.empty() || submaps_.back().frame_id != frame_id) {
-    SubmapRecord s;
-    s.index = static_cast<uint32_t>(submaps_.size());
-    s.frame_id = frame_id;
-    if (pending_origin_ && pending_origin_->new_frame_id == frame_id) {
-      s.origin = pending_origin_;
-      s.reason = last_reason_;
-    }
-    s.first_stamp = stamp;
-    submaps_.push_back(s);
+SubmapRecord* Mapd::Current(uint32_t frame_id, Time stamp) {
+  if (!submaps_.empty() && submaps_.back().frame_id == frame_id) return &submaps_.back();
+  const bool matches_origin = pending_origin_ && pending_origin_->new_frame_id == frame_id;
+  const bool answers_request = last_reason_ && request_frame_ != frame_id;
+  // Only frames this process saw begin are its submaps: the mission's first
+  // frame, or one that answers a request or comes with its switch record. A
+  // frame joined half-way (after a restart) is not.
+  if (frame_id != 0 && !matches_origin && !answers_request) return nullptr;
+  SubmapRecord s;
+  s.index = static_cast<uint32_t>(submaps_.size());
+  s.frame_id = frame_id;
+  if (matches_origin) {
+    s.origin = pending_origin_;
     pending_origin_.reset();
-    PublishStatus();
   }
-  return submaps_.back();
+  if (answers_request) {
+    s.reason = last_reason_;
+    last_reason_.reset();
+  }
+  s.first_stamp = stamp;
+  submaps_.push_back(s);
+  PublishStatus();
+  return &submaps_.back();
 }
 
 void Mapd::OnPose(const topics::PoseMsg& pose) {
@@ -124,13 +139,12 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
   const Eigen::Vector3d p(pose.p_local_body_m[0], pose.p_local_body_m[1], pose.p_local_body_m[2]);
   const std::optional<topics::SwitchReason> reason =
       trigger_.OnPose(stamp, pose.frame_id, p, pose.position_sigma_m);
-  // A frame joined mid-way (restart) is not a submap of this process: only
-  // frames begun by a switch it saw are.
-  if (pending_origin_ || !submaps_.empty() || pose.frame_id == 0) {
-    SubmapRecord& s = Current(pose.frame_id, stamp);
-    ++s.poses;
-    s.last_stamp = stamp;
-    s.distance_m = trigger_.distance_m();
+  // The request this estimate may trigger belongs to the next frame: record
+  // the estimate first.
+  if (SubmapRecord* s = Current(pose.frame_id, stamp)) {
+    ++s->poses;
+    s->last_stamp = stamp;
+    s->distance_m = trigger_.distance_m();
   }
   if (!reason) return;
   const bool sent = requests_->PublishInPlace([&](topics::FrameSwitchRequestMsg& m) {
@@ -146,6 +160,7 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
   ++next_request_id_;
   ++stats_.requests;
   last_reason_ = reason;
+  request_frame_ = pose.frame_id;
 }
 
 void Mapd::OnFrame(const topics::StereoFrameMsg& frame) {

@@ -86,7 +86,9 @@ class Mapd {
   void OnPose(const runtime::topics::PoseMsg& pose);
   void OnFrameSwitch(const runtime::topics::FrameSwitchMsg& record);
   void OnFrame(const runtime::topics::StereoFrameMsg& frame);
-  SubmapRecord& Current(uint32_t frame_id, Time stamp);
+  /// The record of `frame_id`'s submap, opened if this process saw the frame
+  /// begin; nullptr for a frame joined half-way.
+  SubmapRecord* Current(uint32_t frame_id, Time stamp);
   void PublishStatus();
 
   MapdOptions options_;
@@ -100,7 +102,8 @@ class Mapd {
   std::unique_ptr<runtime::topics::StereoFrameMsg> frame_buffer_;
   std::vector<SubmapRecord> submaps_;
   std::optional<runtime::topics::FrameSwitchMsg> pending_origin_;
-  std::optional<runtime::topics::SwitchReason> last_reason_;
+  std::optional<runtime::topics::SwitchReason> last_reason_;  ///< of the request out
+  std::optional<uint32_t> request_frame_;  ///< the frame that request was made in
   MapdStats stats_;
   uint64_t next_request_id_ = 1;
   Time last_status_wall_;

@@ -99,6 +99,32 @@ TEST_F(MapdTest, ASwitchOpensASubmapWithItsOriginAndDistanceTriggersTheNext) {
   EXPECT_EQ(mapd_.stats().poses, 82u);
 }
 
+TEST_F(MapdTest, ARestartedMapdRecordsOnlyTheSubmapItAskedForWhateverArrivesFirst) {
+  // Joined in frame 4 (a restart): asks for a switch, keeps no record of 4.
+  Pose(1.0, 4, 0.0);
+  mapd_.Poll();
+  ASSERT_EQ(Requests().size(), 1u);
+  Pose(1.1, 4, 0.1);
+  mapd_.Poll();
+  EXPECT_TRUE(mapd_.submaps().empty()) << "frame 4 was joined half-way";
+  // The new frame's estimates arrive before its switch record.
+  Pose(1.2, 5, 0.0);
+  mapd_.Poll();
+  ASSERT_EQ(mapd_.submaps().size(), 1u);
+  EXPECT_EQ(mapd_.submaps()[0].frame_id, 5u);
+  ASSERT_TRUE(mapd_.submaps()[0].reason.has_value());
+  EXPECT_EQ(*mapd_.submaps()[0].reason, topics::SwitchReason::kRestart);
+  EXPECT_FALSE(mapd_.submaps()[0].origin.has_value());
+  topics::FrameSwitchMsg sw;
+  sw.old_frame_id = 4;
+  sw.new_frame_id = 5;
+  sw.p_old_new_m = {0.25, 0.0, 0.0};
+  ASSERT_TRUE(switches_->Publish(sw));
+  mapd_.Poll();
+  ASSERT_TRUE(mapd_.submaps()[0].origin.has_value()) << "attached when it arrives";
+  EXPECT_DOUBLE_EQ(mapd_.submaps()[0].origin->p_old_new_m[0], 0.25);
+}
+
 TEST_F(MapdTest, IgnoresMessagesOfAnotherTopicsVersion) {
   topics::PoseMsg m;
   m.version = topics::kTopicsVersion + 1;
