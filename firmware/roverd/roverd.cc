@@ -33,6 +33,13 @@ cv::Mat View(const drivers::ImageView& v) {
 
 }  // namespace
 
+void ApplyBoard(const runtime::BoardConfig& board, RoverdOptions* options) {
+  options->camera_thread = board.threads.camera;
+  options->can_thread = board.threads.can;
+  options->vo_thread = board.threads.vo;
+  options->health = board.health;
+}
+
 Roverd::Roverd(const RoverdOptions& options, const RoverdDrivers& drivers,
                const EstimatorLogChannels& channels, const RoverdOutputs& outputs)
     : options_(options),

@@ -33,6 +33,7 @@
 #include "firmware/roverd/image_logger.h"
 #include "firmware/roverd/lockstep_gate.h"
 #include "firmware/roverd/mapd_link.h"
+#include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/health/health_options.h"
 #include "firmware/runtime/health/health_report.h"
 #include "firmware/runtime/health/sensor_monitor.h"
@@ -82,6 +83,10 @@ struct RoverdOptions {
   /// Nominal rate of the CAN wheel readings (one per SYNC).
   double wheel_rate_hz = 100.0;
 };
+
+/// Takes the board profile's scheduling of the worker threads and its health
+/// settings (the IMU thread is its caller's, see RoverdProcessOptions).
+void ApplyBoard(const runtime::BoardConfig& board, RoverdOptions* options);
 
 /// The flight-log channel of the health reports.
 using DiagnosticsChannel = log::LogChannel<log::diagnostic_msgs::DiagnosticArray, 16384, 64>;

@@ -73,13 +73,7 @@ int main(int argc, char** argv) {
   }
   try {
     rover::roverd::RoverdOptions options = replay->options();
-    options.camera_thread = board.threads.camera;
-    options.can_thread = board.threads.can;
-    options.vo_thread = board.threads.vo;
-    options.health.period_s = board.health.period_s;
-    options.health.stale_after_s = board.health.stale_after_s;
-    options.health.rate_warn_fraction = board.health.rate_warn_fraction;
-    options.health.watchdog = board.health.watchdog;
+    rover::roverd::ApplyBoard(board, &options);
 
     rover::roverd::RoverdProcessOptions process;
     process.log_path = (std::filesystem::path(board.log.folder) / LogName()).string();

@@ -144,12 +144,12 @@ Problem FindProblem(const BoardConfig& c) {
                              BoardIpcOptions::kMaxRoudiWaitS, false, "a wait (s)")) {
     return p;
   }
-  if (Problem p = CheckRange("health.period_s", c.health.period_s, BoardHealthOptions::kMinPeriodS,
-                             BoardHealthOptions::kMaxPeriodS, false, "a period (s)")) {
+  if (Problem p = CheckRange("health.period_s", c.health.period_s, HealthOptions::kMinPeriodS,
+                             HealthOptions::kMaxPeriodS, false, "a period (s)")) {
     return p;
   }
   if (Problem p = CheckRange("health.stale_after_s", c.health.stale_after_s, 0.0,
-                             BoardHealthOptions::kMaxStaleAfterS, true, "a duration (s)")) {
+                             HealthOptions::kMaxStaleAfterS, true, "a duration (s)")) {
     return p;
   }
   if (Problem p = CheckRange("health.rate_warn_fraction", c.health.rate_warn_fraction, 0.0, 1.0,

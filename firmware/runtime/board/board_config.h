@@ -33,6 +33,7 @@
 #include <string_view>
 
 #include "core/config/config.h"
+#include "firmware/runtime/health/health_options.h"
 #include "firmware/runtime/log_service/log_service_options.h"
 #include "firmware/runtime/rt/rt_setup.h"
 #include "firmware/runtime/rt/rt_thread_options.h"
@@ -124,25 +125,6 @@ struct BoardIpcOptions {
   double roudi_wait_s = 5.0;
 };
 
-/// `health:` the health monitor and the systemd watchdog. A plain struct so
-/// this header does not depend on firmware/runtime/health; it has the same
-/// keys, defaults and ranges as runtime::HealthOptions there, so either can
-/// read the section.
-struct BoardHealthOptions {
-  static constexpr double kMinPeriodS = 0.01;
-  static constexpr double kMaxPeriodS = 60.0;
-  static constexpr double kMaxStaleAfterS = 60.0;
-  /// How often the health report is computed and published, s.
-  double period_s = 1.0;
-  /// A thread or input without a heartbeat for this long is stale, s.
-  double stale_after_s = 1.0;
-  /// A sensor below this fraction of its nominal rate is a warning, in
-  /// [0, 1]; 0 disables the rate check.
-  double rate_warn_fraction = 0.9;
-  /// Ping the systemd watchdog (sd_notify WATCHDOG=1) while healthy.
-  bool watchdog = true;
-};
-
 /// `mapd:` the mapping process.
 struct BoardMapdOptions {
   static constexpr double kMaxSubmapDistanceM = 1000.0;
@@ -169,7 +151,8 @@ struct BoardConfig {
   /// Absent: the HTTP log service is off.
   std::optional<LogServiceOptions> log_service;
   BoardIpcOptions ipc;
-  BoardHealthOptions health;
+  /// `health:` the health thread and the systemd watchdog.
+  HealthOptions health;
   BoardMapdOptions mapd;
 
   /// Reads and validates the YAML file at `path` (see Load). Throws

@@ -133,18 +133,6 @@ std::string Fixed(double v, int digits) {
 
 }  // namespace
 
-// The board profile's scheduling and health settings (the IMU thread's own
-// options are applied where RunMission starts it).
-void ApplyBoard(const runtime::BoardConfig& board, roverd::RoverdOptions* rover) {
-  rover->camera_thread = board.threads.camera;
-  rover->can_thread = board.threads.can;
-  rover->vo_thread = board.threads.vo;
-  rover->health.period_s = board.health.period_s;
-  rover->health.stale_after_s = board.health.stale_after_s;
-  rover->health.rate_warn_fraction = board.health.rate_warn_fraction;
-  rover->health.watchdog = board.health.watchdog;
-}
-
 MissionResult RunMission(const MissionOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   MissionResult result;
@@ -190,7 +178,7 @@ MissionResult RunMission(const MissionOptions& options) {
   head.vo.checks.nominal_rate_hz = scenario.camera.rate_hz;
   rover.camera = head;
   rover.lockstep = options.lockstep;
-  if (options.board) ApplyBoard(*options.board, &rover);
+  if (options.board) roverd::ApplyBoard(*options.board, &rover);
 
   result.log_path =
       (fs::path(options.out_dir) / ("mission-" + options.scenario + ".mcap")).string();
