@@ -16,6 +16,8 @@ if(NOT ROVER_FUZZ)
   pkg_check_modules(APRILTAG REQUIRED IMPORTED_TARGET apriltag)
   find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
   find_package(Ceres 2.1 REQUIRED)
+  # Submap voxels and the composed global map (mapping/submap, mapping/compose).
+  find_package(octomap 1.9 REQUIRED)
   # Log service (firmware/runtime/log_service) and rover-log list/download:
   # cpp-httplib is a compiled library on Debian (its pkg-config flags select
   # the OpenSSL/zlib/brotli build it was compiled with); SHA-256 via libcrypto.

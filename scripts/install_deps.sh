@@ -37,6 +37,7 @@ DEBIAN_PACKAGES=(
   libgl-dev                  # OpenGL API used by the renderer
   libegl-mesa0               # Mesa's EGL driver (surfaceless platform, no display needed)
   libgl1-mesa-dri            # Mesa's llvmpipe software rasteriser: renders without a GPU
+  liboctomap-dev             # submap voxels and the global map (mapping/submap, mapping/compose): .bt/.ot
   libceres-dev               # pose-graph back end (mapping/graph, rover-graph): Manifold API, sparse Cholesky
   rt-tests                   # cyclictest: reference wake-up latency for scripts/rt_latency.sh
   libsystemd-dev             # sd_notify: roverd's systemd watchdog and readiness notification

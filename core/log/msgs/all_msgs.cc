@@ -25,7 +25,12 @@ constexpr std::array kAllSchemas = {
     SchemaOf<geometry_msgs::TransformStamped>(),
     SchemaOf<sensor_msgs::Imu>(),
     SchemaOf<sensor_msgs::Image>(),
+    SchemaOf<sensor_msgs::PointField>(),
+    SchemaOf<sensor_msgs::PointCloud2>(),
     SchemaOf<nav_msgs::Odometry>(),
+    SchemaOf<nav_msgs::MapMetaData>(),
+    SchemaOf<nav_msgs::OccupancyGrid>(),
+    SchemaOf<octomap_msgs::Octomap>(),
     SchemaOf<tf2_msgs::TFMessage>(),
     SchemaOf<diagnostic_msgs::KeyValue>(),
     SchemaOf<diagnostic_msgs::DiagnosticStatus>(),
@@ -38,6 +43,7 @@ constexpr std::array kAllSchemas = {
     SchemaOf<rover_msgs::EstimatorWheelSpeeds>(),
     SchemaOf<rover_msgs::EstimatorState>(),
     SchemaOf<rover_msgs::EstimatorFrameSwitch>(),
+    SchemaOf<rover_msgs::SubmapInfo>(),
 };
 
 }  // namespace

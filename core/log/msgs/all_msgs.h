@@ -14,6 +14,7 @@
 #include "core/log/msgs/inline_string.h"
 #include "core/log/msgs/message_traits.h"
 #include "core/log/msgs/nav_msgs.h"
+#include "core/log/msgs/octomap_msgs.h"
 #include "core/log/msgs/rover_msgs.h"
 #include "core/log/msgs/sensor_msgs.h"
 #include "core/log/msgs/std_msgs.h"

@@ -73,6 +73,45 @@ constexpr std::array kOwnTexts = {
             "uint8 is_bigendian\n"
             "uint32 step\n"
             "uint8[] data"},
+    OwnText{"sensor_msgs/PointField",
+            "uint8 INT8=1\n"
+            "uint8 UINT8=2\n"
+            "uint8 INT16=3\n"
+            "uint8 UINT16=4\n"
+            "uint8 INT32=5\n"
+            "uint8 UINT32=6\n"
+            "uint8 FLOAT32=7\n"
+            "uint8 FLOAT64=8\n"
+            "string name\n"
+            "uint32 offset\n"
+            "uint8 datatype\n"
+            "uint32 count"},
+    OwnText{"sensor_msgs/PointCloud2",
+            "std_msgs/Header header\n"
+            "uint32 height\n"
+            "uint32 width\n"
+            "PointField[] fields\n"
+            "bool is_bigendian\n"
+            "uint32 point_step\n"
+            "uint32 row_step\n"
+            "uint8[] data\n"
+            "bool is_dense"},
+    OwnText{"nav_msgs/MapMetaData",
+            "builtin_interfaces/Time map_load_time\n"
+            "float32 resolution\n"
+            "uint32 width\n"
+            "uint32 height\n"
+            "geometry_msgs/Pose origin"},
+    OwnText{"nav_msgs/OccupancyGrid",
+            "std_msgs/Header header\n"
+            "MapMetaData info\n"
+            "int8[] data"},
+    OwnText{"octomap_msgs/Octomap",
+            "std_msgs/Header header\n"
+            "bool binary\n"
+            "string id\n"
+            "float64 resolution\n"
+            "int8[] data"},
     OwnText{"nav_msgs/Odometry",
             "std_msgs/Header header\n"
             "string child_frame_id\n"
@@ -153,6 +192,22 @@ constexpr std::array kOwnTexts = {
             "float64[3] p_old_new_m\n"
             "float64 yaw_old_new_rad\n"
             "float64[16] covariance"},
+    OwnText{"rover_msgs/SubmapInfo",
+            "std_msgs/Header header\n"
+            "uint32 index\n"
+            "uint32 frame_id\n"
+            "bool has_origin\n"
+            "uint32 previous_frame_id\n"
+            "int64 origin_stamp_ns\n"
+            "float64[3] p_previous_origin_m\n"
+            "float64 yaw_previous_origin_rad\n"
+            "float64[16] origin_covariance\n"
+            "int64 first_stamp_ns\n"
+            "int64 last_stamp_ns\n"
+            "uint32 images\n"
+            "float64 distance_m\n"
+            "uint64 octree_bytes\n"
+            "uint64 cloud_bytes"},
 };
 
 // The primitive types of the ROS 2 interface definition language.

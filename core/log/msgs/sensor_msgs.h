@@ -47,10 +47,49 @@ struct Image {
   friend bool operator==(const Image&, const Image&) = default;
 };
 
+/// sensor_msgs/msg/PointField: one field of a PointCloud2 point.
+struct PointField {
+  static constexpr uint8_t kInt8 = 1;
+  static constexpr uint8_t kUint8 = 2;
+  static constexpr uint8_t kInt16 = 3;
+  static constexpr uint8_t kUint16 = 4;
+  static constexpr uint8_t kInt32 = 5;
+  static constexpr uint8_t kUint32 = 6;
+  static constexpr uint8_t kFloat32 = 7;
+  static constexpr uint8_t kFloat64 = 8;
+
+  std::string name;
+  uint32_t offset = 0;  // Bytes from the start of the point.
+  uint8_t datatype = 0;
+  uint32_t count = 1;  // Elements in the field.
+
+  friend bool operator==(const PointField&, const PointField&) = default;
+};
+
+/// sensor_msgs/msg/PointCloud2: `height` rows of `width` points, each
+/// `point_step` bytes laid out by `fields`. Host-side (vectors).
+struct PointCloud2 {
+  std_msgs::Header header;
+  uint32_t height = 1;
+  uint32_t width = 0;
+  std::vector<PointField> fields;
+  bool is_bigendian = false;
+  uint32_t point_step = 0;
+  uint32_t row_step = 0;
+  std::vector<uint8_t> data;
+  bool is_dense = true;
+
+  friend bool operator==(const PointCloud2&, const PointCloud2&) = default;
+};
+
 void Serialize(const Imu& msg, CdrWriter& writer);
 void Serialize(const Image& msg, CdrWriter& writer);
+void Serialize(const PointField& msg, CdrWriter& writer);
+void Serialize(const PointCloud2& msg, CdrWriter& writer);
 bool Deserialize(CdrReader& reader, Imu* msg);
 bool Deserialize(CdrReader& reader, Image* msg);
+bool Deserialize(CdrReader& reader, PointField* msg);
+bool Deserialize(CdrReader& reader, PointCloud2* msg);
 
 }  // namespace sensor_msgs
 
@@ -63,6 +102,18 @@ struct MessageTraits<sensor_msgs::Imu> {
 template <>
 struct MessageTraits<sensor_msgs::Image> {
   static constexpr std::string_view kName = "sensor_msgs/msg/Image";
+  static std::string_view Definition();
+};
+
+template <>
+struct MessageTraits<sensor_msgs::PointField> {
+  static constexpr std::string_view kName = "sensor_msgs/msg/PointField";
+  static std::string_view Definition();
+};
+
+template <>
+struct MessageTraits<sensor_msgs::PointCloud2> {
+  static constexpr std::string_view kName = "sensor_msgs/msg/PointCloud2";
   static std::string_view Definition();
 };
 

@@ -101,6 +101,59 @@ class RandomMessages {
     m->data.resize(static_cast<size_t>(Uniform(0, 67)));
     for (uint8_t& b : m->data) b = static_cast<uint8_t>(rng_());
   }
+  void Fill(sensor_msgs::PointField* m) {
+    m->name = Text(9);
+    m->offset = static_cast<uint32_t>(rng_());
+    m->datatype = static_cast<uint8_t>(Uniform(1, 8));
+    m->count = static_cast<uint32_t>(rng_());
+  }
+  void Fill(sensor_msgs::PointCloud2* m) {
+    Fill(&m->header);
+    m->height = static_cast<uint32_t>(rng_());
+    m->width = static_cast<uint32_t>(rng_());
+    FillVector(&m->fields);
+    m->is_bigendian = Uniform(0, 1) == 1;
+    m->point_step = static_cast<uint32_t>(rng_());
+    m->row_step = static_cast<uint32_t>(rng_());
+    FillOctets(&m->data);
+    m->is_dense = Uniform(0, 1) == 1;
+  }
+  void Fill(nav_msgs::MapMetaData* m) {
+    Fill(&m->map_load_time);
+    m->resolution = static_cast<float>(Real());
+    m->width = static_cast<uint32_t>(rng_());
+    m->height = static_cast<uint32_t>(rng_());
+    Fill(&m->origin);
+  }
+  void Fill(nav_msgs::OccupancyGrid* m) {
+    Fill(&m->header);
+    Fill(&m->info);
+    FillOctets(&m->data);
+  }
+  void Fill(octomap_msgs::Octomap* m) {
+    Fill(&m->header);
+    m->binary = Uniform(0, 1) == 1;
+    m->id = Text(10);
+    m->resolution = Real();
+    FillOctets(&m->data);
+  }
+  void Fill(rover_msgs::SubmapInfo* m) {
+    Fill(&m->header);
+    m->index = static_cast<uint32_t>(rng_());
+    m->frame_id = static_cast<uint32_t>(rng_());
+    m->has_origin = Uniform(0, 1) == 1;
+    m->previous_frame_id = static_cast<uint32_t>(rng_());
+    m->origin_stamp_ns = static_cast<int64_t>(rng_());
+    FillArray(&m->p_previous_origin_m);
+    m->yaw_previous_origin_rad = Real();
+    FillArray(&m->origin_covariance);
+    m->first_stamp_ns = static_cast<int64_t>(rng_());
+    m->last_stamp_ns = static_cast<int64_t>(rng_());
+    m->images = static_cast<uint32_t>(rng_());
+    m->distance_m = Real();
+    m->octree_bytes = rng_();
+    m->cloud_bytes = rng_();
+  }
   void Fill(nav_msgs::Odometry* m) {
     Fill(&m->header);
     m->child_frame_id = FrameId::Truncated(Text(FrameId::kCapacity));
@@ -222,6 +275,13 @@ class RandomMessages {
     for (double& v : *values) v = Real();
   }
 
+  // 0..67 octets: every alignment of what follows.
+  template <typename Octet>
+  void FillOctets(std::vector<Octet>* values) {
+    values->resize(static_cast<size_t>(Uniform(0, 67)));
+    for (Octet& b : *values) b = static_cast<Octet>(rng_());
+  }
+
   template <typename T>
   void FillVector(std::vector<T>* values) {
     values->resize(static_cast<size_t>(Uniform(0, 4)));
@@ -237,11 +297,13 @@ using AllMessageTypes = ::testing::Types<
     geometry_msgs::Quaternion, geometry_msgs::Pose, geometry_msgs::PoseWithCovariance,
     geometry_msgs::PoseWithCovarianceStamped, geometry_msgs::Twist,
     geometry_msgs::TwistWithCovariance, geometry_msgs::Transform, geometry_msgs::TransformStamped,
-    sensor_msgs::Imu, sensor_msgs::Image, nav_msgs::Odometry, tf2_msgs::TFMessage,
-    diagnostic_msgs::KeyValue, diagnostic_msgs::DiagnosticStatus, diagnostic_msgs::DiagnosticArray,
-    rover_msgs::LogChannelHealth, rover_msgs::LogHealth, rover_msgs::EstimatorImu,
-    rover_msgs::EstimatorEvent, rover_msgs::EstimatorRelativePose, rover_msgs::EstimatorWheelSpeeds,
-    rover_msgs::EstimatorState, rover_msgs::EstimatorFrameSwitch>;
+    sensor_msgs::Imu, sensor_msgs::Image, sensor_msgs::PointField, sensor_msgs::PointCloud2,
+    nav_msgs::Odometry, nav_msgs::MapMetaData, nav_msgs::OccupancyGrid, octomap_msgs::Octomap,
+    tf2_msgs::TFMessage, diagnostic_msgs::KeyValue, diagnostic_msgs::DiagnosticStatus,
+    diagnostic_msgs::DiagnosticArray, rover_msgs::LogChannelHealth, rover_msgs::LogHealth,
+    rover_msgs::EstimatorImu, rover_msgs::EstimatorEvent, rover_msgs::EstimatorRelativePose,
+    rover_msgs::EstimatorWheelSpeeds, rover_msgs::EstimatorState, rover_msgs::EstimatorFrameSwitch,
+    rover_msgs::SubmapInfo>;
 
 /// gtest names for AllMessageTypes instances: the ROS type name.
 struct MessageTypeName {
