@@ -2,10 +2,15 @@
 
 #include <unistd.h>
 
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
+#include <opencv2/core.hpp>
+
 #include "estimator/eskf/eskf_output.h"
+#include "firmware/mapd/submap_archive.h"
 
 namespace rover::mapd {
 namespace {
@@ -41,10 +46,51 @@ std::unique_ptr<ipc::Publisher<T>> Advertise(ipc::Transport* transport, std::str
   return p;
 }
 
+estimator::vo::CameraModel CameraOf(const topics::CameraCalibrationMsg& m) {
+  estimator::vo::CameraModel c;
+  c.width_px = m.width_px;
+  c.height_px = m.height_px;
+  c.intrinsics = m.intrinsics;
+  c.distortion = m.distortion;
+  const Eigen::Quaterniond q(m.q_body_cam_wxyz[0], m.q_body_cam_wxyz[1], m.q_body_cam_wxyz[2],
+                             m.q_body_cam_wxyz[3]);
+  c.T_body_cam.linear() = q.normalized().toRotationMatrix();
+  c.T_body_cam.translation() =
+      Eigen::Vector3d(m.p_body_cam_m[0], m.p_body_cam_m[1], m.p_body_cam_m[2]);
+  return c;
+}
+
+StampedPose PoseOf(const topics::PoseMsg& m) {
+  StampedPose p;
+  p.stamp = Time::FromNanoseconds(m.stamp_ns);
+  p.frame_id = m.frame_id;
+  const auto& q = m.q_local_body_wxyz;
+  p.T_local_body.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
+  p.T_local_body.translation() =
+      Eigen::Vector3d(m.p_local_body_m[0], m.p_local_body_m[1], m.p_local_body_m[2]);
+  return p;
+}
+
 }  // namespace
 
+void MapdOptions::Validate() const {
+  if (!(max_mapping_rate_hz >= 0.0) || !std::isfinite(max_mapping_rate_hz)) {
+    throw std::invalid_argument("MapdOptions.max_mapping_rate_hz: expected >= 0, got " +
+                                std::to_string(max_mapping_rate_hz));
+  }
+  if (pose_history < 2) {
+    throw std::invalid_argument("MapdOptions.pose_history: expected >= 2 estimates, got " +
+                                std::to_string(pose_history));
+  }
+  if (!(traversability_period > Duration::Zero())) {
+    throw std::invalid_argument("MapdOptions.traversability_period: expected > 0 s");
+  }
+  local_mapper.Validate();
+  submap.Validate();
+}
+
 Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
-    : options_(options),
+    : options_((options.Validate(), options)),
       trigger_(options.trigger),
       poses_(Subscribe<topics::PoseMsg>(transport, topics::kPoseTopic, options.pose_queue)),
       // Two frames: a slow mapd works on the newest pair, never on a backlog.
@@ -54,11 +100,32 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
           Advertise<topics::FrameSwitchRequestMsg>(transport, topics::kFrameSwitchRequestTopic, 0)),
       // History 1: whoever connects later sees mapd's state at once.
       status_(Advertise<topics::MapdStatusMsg>(transport, topics::kMapdStatusTopic, 1)),
-      frame_buffer_(std::make_unique<topics::StereoFrameMsg>()) {
+      frame_buffer_(std::make_unique<topics::StereoFrameMsg>()),
+      history_(options.pose_history) {
+  if (options_.mapping) {
+    std::string error;
+    // History 1: roverd published the calibration once, maybe long ago.
+    calibration_ = transport->MakeSubscriber<topics::StereoCalibrationMsg>(
+        TopicOf(topics::kStereoCalibrationTopic), {.queue_capacity = 1, .history_request = 1},
+        &error);
+    if (calibration_ == nullptr) {
+      throw std::runtime_error("mapd: cannot subscribe to " +
+                               std::string(topics::kStereoCalibrationTopic) + ": " + error);
+    }
+    pending_frame_ = std::make_unique<topics::StereoFrameMsg>();
+    archive_ = std::make_unique<SubmapArchive>(options_.output_stem, options_.robot_name,
+                                               mapping::MapComposerOptions{});
+  }
   trigger_.RequestAtNextPose();
 }
 
-Mapd::~Mapd() = default;
+Mapd::~Mapd() {
+  try {
+    Shutdown();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mapd: shutting down: %s\n", e.what());
+  }
+}
 
 int Mapd::Poll() {
   int handled = 0;
@@ -74,10 +141,13 @@ int Mapd::Poll() {
     OnPose(pose);
     ++handled;
   }
+  if (calibration_ && !mapper_) TakeCalibration();
+  TryMapPending();
   while (frames_->TryTake(frame_buffer_.get())) {
     OnFrame(*frame_buffer_);
     ++handled;
   }
+  TryMapPending();
   if (poses_->HasMissedData()) ++stats_.missed;
   if (frames_->HasMissedData()) ++stats_.missed;
   const Time now = Time::Now();
@@ -121,7 +191,11 @@ SubmapRecord* Mapd::Current(uint32_t frame_id, Time stamp) {
     last_reason_.reset();
   }
   s.first_stamp = stamp;
+  // The previous frame is over: archive its map now rather than when the
+  // next pair arrives.
+  FinishMappingSubmap();
   submaps_.push_back(s);
+  if (archive_) archive_->OpenFrame(submaps_.back());
   PublishStatus();
   return &submaps_.back();
 }
@@ -132,6 +206,7 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
     return;
   }
   ++stats_.poses;
+  history_.Add(PoseOf(pose));
   // Before the filter has initialised there is no frame to map in, and it
   // would refuse a switch.
   if ((pose.status & estimator::kStatusNotInitialised) != 0) return;
@@ -170,7 +245,167 @@ void Mapd::OnFrame(const topics::StereoFrameMsg& frame) {
   }
   ++stats_.frames;
   if (!submaps_.empty()) ++submaps_.back().frames;
+  if (!stats_.first_sequence) {
+    stats_.first_sequence = frame.sequence;
+    stats_.first_capture_ns = frame.capture_stamp_ns;
+  }
+  stats_.last_sequence = frame.sequence;
+  stats_.last_capture_ns = frame.capture_stamp_ns;
+  stats_.pair_bytes = 2ull * frame.width_px * frame.height_px;
+  if (!pending_frame_) return;
+  const Time capture = Time::FromNanoseconds(frame.capture_stamp_ns);
+  if (options_.max_mapping_rate_hz > 0.0 && last_mapped_capture_ &&
+      (capture - *last_mapped_capture_).ToSeconds() < 1.0 / options_.max_mapping_rate_hz) {
+    ++stats_.images_skipped;
+    return;
+  }
+  if (has_pending_) ++stats_.images_skipped;  // a newer pair replaces it
+  std::swap(pending_frame_, frame_buffer_);
+  has_pending_ = true;
 }
+
+void Mapd::TakeCalibration() {
+  topics::StereoCalibrationMsg m;
+  if (!calibration_->TryTake(&m)) return;
+  if (m.version != topics::kTopicsVersion) {
+    ++stats_.version_mismatches;
+    return;
+  }
+  try {
+    mapper_ =
+        std::make_unique<LocalMapper>(options_.local_mapper, CameraOf(m.cam0), CameraOf(m.cam1));
+    std::fprintf(stderr, "mapd: stereo calibration received (%dx%d px): mapping\n", m.cam0.width_px,
+                 m.cam0.height_px);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mapd: cannot map with roverd's stereo calibration: %s\n", e.what());
+    calibration_.reset();  // do not retry every poll
+  }
+}
+
+void Mapd::TryMapPending() {
+  if (!has_pending_ || !mapper_) return;
+  const Time capture = Time::FromNanoseconds(pending_frame_->capture_stamp_ns);
+  const std::optional<Time> newest = history_.newest();
+  if (!newest || *newest < capture) return;  // its estimates are still on the way
+  has_pending_ = false;
+  const std::optional<StampedPose> pose = history_.At(capture);
+  if (!pose) {
+    ++stats_.images_unplaced;
+    return;
+  }
+  MapPair(*pending_frame_, *pose);
+}
+
+void Mapd::MapPair(const topics::StereoFrameMsg& frame, const StampedPose& pose) {
+  // Only the frames this process saw begin are its submaps.
+  if (submaps_.empty() || submaps_.back().frame_id != pose.frame_id) {
+    ++stats_.images_unplaced;
+    return;
+  }
+  if (mapping_submap_ && mapping_submap_->frame_id() != pose.frame_id) FinishMappingSubmap();
+  if (!mapping_submap_) {
+    mapping_submap_ =
+        std::make_unique<mapping::Submap>(submaps_.back().index, pose.frame_id, options_.submap);
+    mapper_->ResetTraversability();
+  }
+  const auto rows = static_cast<int>(frame.height_px);
+  const auto cols = static_cast<int>(frame.width_px);
+  // Views of the message's packed rows: no copy.
+  const cv::Mat raw0(rows, cols, CV_8UC1, const_cast<uint8_t*>(frame.cam0.data()));
+  const cv::Mat raw1(rows, cols, CV_8UC1, const_cast<uint8_t*>(frame.cam1.data()));
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const MappedImage mapped =
+        mapper_->Process(raw0, raw1, pose.T_local_body, mapping_submap_.get());
+    stats_.obstacle_points += static_cast<uint64_t>(mapped.obstacle_points);
+  } catch (const std::exception& e) {
+    if (stats_.images_failed++ == 0) std::fprintf(stderr, "mapd: mapping a pair: %s\n", e.what());
+    return;
+  }
+  stats_.mapping_ms_total +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  ++stats_.images_mapped;
+  last_mapped_capture_ = Time::FromNanoseconds(frame.capture_stamp_ns);
+  if (!last_traversability_ ||
+      *last_mapped_capture_ - *last_traversability_ >= options_.traversability_period) {
+    LogTraversability(frame.capture_stamp_ns);
+    last_traversability_ = last_mapped_capture_;
+  }
+}
+
+void Mapd::LogTraversability(int64_t stamp_ns) {
+  const mapping::TraversabilityGrid& grid = mapper_->traversability();
+  log::nav_msgs::OccupancyGrid msg;
+  msg.header.stamp = log::ToRosTime(Time::FromNanoseconds(stamp_ns));
+  msg.header.frame_id = log::FrameId::Truncated("local/" + options_.robot_name + "/" +
+                                                std::to_string(mapping_submap_->frame_id()));
+  const int n = grid.cells_per_side();
+  msg.info.map_load_time = msg.header.stamp;
+  msg.info.resolution = static_cast<float>(grid.resolution_m());
+  msg.info.width = static_cast<uint32_t>(n);
+  msg.info.height = static_cast<uint32_t>(n);
+  msg.info.origin.position.x = grid.origin_xy().x();
+  msg.info.origin.position.y = grid.origin_xy().y();
+  msg.data.resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(n));
+  // h_diff / (h_max + Delta_d) of 1 (the limit) maps to 65, map_server's
+  // default occupied threshold, so ROS tools draw the same boundary.
+  for (int iy = 0; iy < n; ++iy) {
+    for (int ix = 0; ix < n; ++ix) {
+      const float v = grid.value(ix, iy);
+      msg.data[static_cast<std::size_t>(iy) * static_cast<std::size_t>(n) +
+               static_cast<std::size_t>(ix)] =
+          v < 0.0f ? int8_t{-1} : static_cast<int8_t>(std::lround(std::min(100.0f, 65.0f * v)));
+    }
+  }
+  archive_->LogTraversability(msg);
+}
+
+void Mapd::FinishMappingSubmap() {
+  if (!mapping_submap_) return;
+  mapping_submap_->Finish();
+  const SubmapRecord* record = nullptr;
+  for (const SubmapRecord& r : submaps_) {
+    if (r.frame_id == mapping_submap_->frame_id()) record = &r;
+  }
+  if (record != nullptr && mapping_submap_->images() > 0) {
+    const ArchivedBytes bytes = archive_->Add(*record, *mapping_submap_);
+    stats_.octree_bytes += bytes.octree;
+    stats_.cloud_bytes += bytes.cloud;
+    ++stats_.submaps_archived;
+  }
+  mapping_submap_.reset();
+}
+
+MapdBandwidth Mapd::Bandwidth() const {
+  MapdBandwidth b;
+  const double span_s =
+      static_cast<double>(stats_.last_capture_ns - stats_.first_capture_ns) * 1e-9;
+  if (!stats_.first_sequence || span_s <= 0.0) return b;
+  // Sequence numbers count every pair the camera captured, including those
+  // mapd never took: the raw rate is the camera's.
+  const double pairs = static_cast<double>(stats_.last_sequence - *stats_.first_sequence);
+  b.raw_stereo_bytes_per_s = pairs * static_cast<double>(stats_.pair_bytes) / span_s;
+  b.submap_bytes_per_s = static_cast<double>(stats_.octree_bytes + stats_.cloud_bytes) / span_s;
+  return b;
+}
+
+void Mapd::Shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  if (!archive_) return;
+  FinishMappingSubmap();
+  const MapdBandwidth b = Bandwidth();
+  archive_->Close({{"submaps", std::to_string(stats_.submaps_archived)},
+                   {"images_mapped", std::to_string(stats_.images_mapped)},
+                   {"images_skipped", std::to_string(stats_.images_skipped)},
+                   {"images_unplaced", std::to_string(stats_.images_unplaced)},
+                   {"octree_bytes", std::to_string(stats_.octree_bytes)},
+                   {"cloud_bytes", std::to_string(stats_.cloud_bytes)},
+                   {"raw_stereo_bytes_per_s", std::to_string(b.raw_stereo_bytes_per_s)},
+                   {"submap_bytes_per_s", std::to_string(b.submap_bytes_per_s)}});
+}
+
+std::string Mapd::log_path() const { return archive_ ? archive_->log_path() : std::string(); }
 
 void Mapd::PublishStatus() {
   last_status_wall_ = Time::Now();
@@ -191,6 +426,27 @@ std::string Mapd::Summary() const {
                     std::to_string(stats_.poses) + " estimates, " + std::to_string(stats_.frames) +
                     " stereo pairs, " + std::to_string(stats_.requests) + " switch requests, " +
                     std::to_string(stats_.missed) + " queue overflows\n";
+  if (archive_) {
+    const MapdBandwidth b = Bandwidth();
+    char text[320];
+    std::snprintf(text, sizeof(text),
+                  "  mapping: %llu pairs mapped (%.0f ms each), %llu skipped, %llu unplaced, "
+                  "%llu failed; %llu submaps archived, %.1f KB/s as submaps against %.2f MB/s "
+                  "raw stereo (%.3f %%)\n",
+                  static_cast<unsigned long long>(stats_.images_mapped),
+                  stats_.images_mapped > 0
+                      ? stats_.mapping_ms_total / static_cast<double>(stats_.images_mapped)
+                      : 0.0,
+                  static_cast<unsigned long long>(stats_.images_skipped),
+                  static_cast<unsigned long long>(stats_.images_unplaced),
+                  static_cast<unsigned long long>(stats_.images_failed),
+                  static_cast<unsigned long long>(stats_.submaps_archived),
+                  b.submap_bytes_per_s / 1e3, b.raw_stereo_bytes_per_s / 1e6,
+                  b.raw_stereo_bytes_per_s > 0.0
+                      ? 100.0 * b.submap_bytes_per_s / b.raw_stereo_bytes_per_s
+                      : 0.0);
+    out += text;
+  }
   char line[200];
   for (const SubmapRecord& s : submaps_) {
     std::snprintf(

@@ -7,10 +7,13 @@
 // starts (SubmapTrigger) and asks roverd for the frame switch that gives the
 // submap its origin.
 //
-// This is the skeleton and the data flow: each submap records its origin
-// (the switch record, graph factor w), the estimates and frames it received
-// and the distance driven. Depth, terrain classification, the submap's
-// voxels and the pose graph plug in here (mapping/).
+// Each submap records its origin (the switch record, graph factor w), the
+// estimates and frames it received and the distance driven. With mapping on
+// (and roverd's stereo calibration received), every stereo pair is placed
+// at its capture time between the estimates around it and mapped by the
+// LocalMapper (depth, obstacle classification, octree and cloud) into the
+// submap of its frame; finished submaps go to mapd's own log and into the
+// composed global map, written out when mapd stops.
 //
 // A (re)started mapd has lost whatever submap it was building, so its first
 // act is to request a switch (reason "restart"): it resumes with a new
@@ -24,10 +27,16 @@
 
 #include "core/ipc/transport.h"
 #include "core/time/time.h"
+#include "firmware/mapd/local_mapper.h"
+#include "firmware/mapd/pose_history.h"
 #include "firmware/mapd/submap_trigger.h"
 #include "firmware/runtime/topics/rover_topics.h"
+#include "mapping/submap/submap.h"
+#include "mapping/submap/submap_options.h"
 
 namespace rover::mapd {
+
+class SubmapArchive;
 
 struct MapdOptions {
   SubmapTriggerOptions trigger;
@@ -35,6 +44,28 @@ struct MapdOptions {
   Duration status_period = Duration::Seconds(1);
   /// Subscriber queue for the estimates (400 Hz: about 0.6 s).
   uint64_t pose_queue = 256;
+
+  /// Map the stereo pairs (depth, terrain, submap voxels and clouds). Off:
+  /// only the submap bookkeeping above.
+  bool mapping = true;
+  LocalMapperOptions local_mapper{};
+  mapping::SubmapOptions submap{};
+  /// At most this many pairs per second of capture time are mapped (0: all
+  /// that mapd keeps up with); the rest are skipped, newest first.
+  double max_mapping_rate_hz = 2.0;
+  /// Estimates kept to place pairs in time (400 Hz: 10 s).
+  std::size_t pose_history = 4096;
+  /// mapd's log is output_stem + ".mcap" (submaps, traversability), and the
+  /// global map is exported to output_stem + ".bt", ".ot" and ".ply" when
+  /// mapd stops; empty: nothing is written.
+  std::string output_stem{};
+  /// Robot name in frame ids (local/<robot>/<frame>).
+  std::string robot_name = "rover";
+  /// Capture time between traversability grids in the log.
+  Duration traversability_period = Duration::Seconds(1);
+
+  /// Throws std::invalid_argument naming the key.
+  void Validate() const;
 };
 
 /// One submap as mapd saw it.
@@ -61,6 +92,29 @@ struct MapdStats {
   uint64_t request_drops = 0;  ///< no transport buffer
   uint64_t missed = 0;         ///< queue overflows (mapd too slow: frames are expected to be)
   uint64_t version_mismatches = 0;
+  // Mapping.
+  uint64_t images_mapped = 0;
+  uint64_t images_skipped = 0;    ///< over the mapping rate, or replaced while waiting
+  uint64_t images_unplaced = 0;   ///< no estimate around the capture time, or a joined frame
+  uint64_t images_failed = 0;     ///< the pipeline threw (bad size, ...)
+  uint64_t submaps_archived = 0;  ///< finished, logged and composed
+  uint64_t octree_bytes = 0;      ///< serialised octomap_msgs/Octomap of finished submaps
+  uint64_t cloud_bytes = 0;       ///< serialised sensor_msgs/PointCloud2 of finished submaps
+  uint64_t obstacle_points = 0;
+  double mapping_ms_total = 0.0;
+  /// First and last stereo pair seen (any), for the raw stereo byte rate.
+  std::optional<uint64_t> first_sequence;
+  uint64_t last_sequence = 0;
+  int64_t first_capture_ns = 0;
+  int64_t last_capture_ns = 0;
+  uint64_t pair_bytes = 0;  ///< bytes of one raw pair (two mono8 images)
+};
+
+/// Per-second byte rates of a run (thesis: 38.75 MB/s raw stereo against
+/// about 58 KB/s as submaps).
+struct MapdBandwidth {
+  double raw_stereo_bytes_per_s = 0.0;
+  double submap_bytes_per_s = 0.0;
 };
 
 class Mapd {
@@ -79,8 +133,19 @@ class Mapd {
   const std::vector<SubmapRecord>& submaps() const { return submaps_; }
   const MapdStats& stats() const { return stats_; }
 
+  /// Finishes the current submap, writes the run's statistics, the global
+  /// map (map.bt, map.ot, map.ply) and closes the log. Idempotent; the
+  /// destructor calls it.
+  void Shutdown();
+
+  /// Byte rates over the capture time seen so far.
+  MapdBandwidth Bandwidth() const;
+
   /// Human-readable summary for the end of a run.
   std::string Summary() const;
+
+  /// Path of mapd's log (empty: none).
+  std::string log_path() const;
 
  private:
   void OnPose(const runtime::topics::PoseMsg& pose);
@@ -90,6 +155,13 @@ class Mapd {
   /// begin; nullptr for a frame joined half-way.
   SubmapRecord* Current(uint32_t frame_id, Time stamp);
   void PublishStatus();
+  void TakeCalibration();
+  /// Maps the pending pair once the estimates around it have arrived.
+  void TryMapPending();
+  void MapPair(const runtime::topics::StereoFrameMsg& frame, const StampedPose& pose);
+  /// Archives the mapping submap (log, composition) and forgets it.
+  void FinishMappingSubmap();
+  void LogTraversability(int64_t stamp_ns);
 
   MapdOptions options_;
   SubmapTrigger trigger_;
@@ -98,8 +170,19 @@ class Mapd {
   std::unique_ptr<ipc::Subscriber<runtime::topics::FrameSwitchMsg>> switches_;
   std::unique_ptr<ipc::Publisher<runtime::topics::FrameSwitchRequestMsg>> requests_;
   std::unique_ptr<ipc::Publisher<runtime::topics::MapdStatusMsg>> status_;
+  std::unique_ptr<ipc::Subscriber<runtime::topics::StereoCalibrationMsg>> calibration_;
   /// 2 MB: one frame buffer, allocated once.
   std::unique_ptr<runtime::topics::StereoFrameMsg> frame_buffer_;
+  /// The newest pair waiting for its estimates (mapping only).
+  std::unique_ptr<runtime::topics::StereoFrameMsg> pending_frame_;
+  bool has_pending_ = false;
+  PoseHistory history_;
+  std::unique_ptr<LocalMapper> mapper_;
+  std::unique_ptr<mapping::Submap> mapping_submap_;
+  std::unique_ptr<SubmapArchive> archive_;
+  std::optional<Time> last_mapped_capture_;
+  std::optional<Time> last_traversability_;
+  bool shut_down_ = false;
   std::vector<SubmapRecord> submaps_;
   std::optional<runtime::topics::FrameSwitchMsg> pending_origin_;
   std::optional<runtime::topics::SwitchReason> last_reason_;  ///< of the request out

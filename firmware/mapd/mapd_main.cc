@@ -8,7 +8,9 @@
 
 #include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <exception>
+#include <filesystem>
 #include <thread>
 
 #include "core/ipc/iceoryx_transport.h"
@@ -21,6 +23,17 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void OnSignal(int) { g_stop = 1; }
 
+// "mapd-20261121-134501-4711": sortable, one per start (a restart within
+// the same second differs by pid).
+std::string LogStem() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[64];
+  std::strftime(text, sizeof(text), "mapd-%Y%m%d-%H%M%S", &utc);
+  return std::string(text) + "-" + std::to_string(::getpid());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -29,7 +42,10 @@ int main(int argc, char** argv) {
       "frame switches over iceoryx (RouDi must run: scripts/roudi.sh start, or the rover-roudi\n"
       "unit), starts a new submap when the filter's position sigma or the distance driven in\n"
       "the current one exceeds its limit, and asks roverd for the frame switch that gives it\n"
-      "its origin. Stops on SIGTERM or SIGINT and prints its submaps.\n"};
+      "its origin. Maps the stereo pairs (SGBM depth, obstacle classification, 10 cm OctoMap\n"
+      "and 5 cm cloud per submap) into OUT/mapd-<time>-<pid>.mcap. Stops on SIGTERM or SIGINT,\n"
+      "then writes the global map beside the log (.bt, .ot for octovis; .ply) and prints its\n"
+      "submaps.\n"};
   rover::mapd::MapdOptions options;
   std::string runtime_name = "mapd";
   double roudi_wait_s = 5.0;
@@ -47,6 +63,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--roudi-wait-s", roudi_wait_s, "how long to wait for RouDi")
       ->capture_default_str();
+  std::string out_dir;
+  app.add_option("--out", out_dir,
+                 "folder for mapd's log and the exported map (default: the board's log.folder; "
+                 "none without --config)");
+  bool no_mapping = false;
+  app.add_flag("--no-mapping", no_mapping, "only follow the submaps, map nothing");
+  app.add_option("--mapping-rate-hz", options.max_mapping_rate_hz,
+                 "pairs mapped per second of capture time at most (0: all mapd keeps up with)")
+      ->capture_default_str();
+  app.add_option("--robot", options.robot_name, "robot name in frame ids (default: board.name)");
   CLI11_PARSE(app, argc, argv);
   if (!config.empty()) {
     try {
@@ -58,10 +84,20 @@ int main(int argc, char** argv) {
         options.trigger.max_position_sigma_m = board.mapd.submap_max_position_sigma_m;
       }
       if (app.get_option("--roudi-wait-s")->count() == 0) roudi_wait_s = board.ipc.roudi_wait_s;
+      if (app.get_option("--mapping-rate-hz")->count() == 0) {
+        options.max_mapping_rate_hz = board.mapd.mapping_rate_hz;
+      }
+      if (!board.mapd.mapping) options.mapping = false;
+      if (out_dir.empty()) out_dir = board.log.folder;
+      if (app.get_option("--robot")->count() == 0) options.robot_name = board.board.name;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "mapd: %s\n", e.what());
       return 78;  // EX_CONFIG: systemd does not restart a bad configuration
     }
+  }
+  if (no_mapping) options.mapping = false;
+  if (!out_dir.empty() && options.mapping) {
+    options.output_stem = (std::filesystem::path(out_dir) / LogStem()).string();
   }
   std::signal(SIGTERM, OnSignal);
   std::signal(SIGINT, OnSignal);
@@ -91,7 +127,12 @@ int main(int argc, char** argv) {
       }
     }
     notifier.Stopping();
+    mapd.Shutdown();
     std::fprintf(stderr, "%s", mapd.Summary().c_str());
+    if (!mapd.log_path().empty()) {
+      std::fprintf(stderr, "mapd: log %s, global map %s.{bt,ot,ply}\n", mapd.log_path().c_str(),
+                   options.output_stem.c_str());
+    }
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mapd: %s\n", e.what());

@@ -16,11 +16,12 @@ namespace {
 namespace topics = runtime::topics;
 
 template <typename T>
-std::unique_ptr<ipc::Publisher<T>> MakePublisher(ipc::Transport* transport, std::string_view name) {
+std::unique_ptr<ipc::Publisher<T>> MakePublisher(ipc::Transport* transport, std::string_view name,
+                                                 const ipc::PublisherOptions& options = {}) {
   std::string error;
   const std::optional<ipc::Topic> topic = ipc::Topic::Parse(name, &error);
   std::unique_ptr<ipc::Publisher<T>> p;
-  if (topic) p = transport->MakePublisher<T>(*topic, {}, &error);
+  if (topic) p = transport->MakePublisher<T>(*topic, options, &error);
   if (p == nullptr)
     throw std::runtime_error("mapd link: cannot publish " + std::string(name) + ": " + error);
   return p;
@@ -35,9 +36,31 @@ void CopyPacked(const drivers::ImageView& view, uint8_t* dst) {
   }
 }
 
+topics::CameraCalibrationMsg ToCameraMsg(const estimator::vo::CameraModel& cam) {
+  topics::CameraCalibrationMsg m;
+  m.width_px = cam.width_px;
+  m.height_px = cam.height_px;
+  m.intrinsics = cam.intrinsics;
+  m.distortion = cam.distortion;
+  const Eigen::Vector3d p = cam.T_body_cam.translation();
+  const Eigen::Quaterniond q(cam.T_body_cam.linear());
+  m.p_body_cam_m = {p.x(), p.y(), p.z()};
+  m.q_body_cam_wxyz = {q.w(), q.x(), q.y(), q.z()};
+  return m;
+}
+
 }  // namespace
 
-MapdLink::MapdLink(ipc::Transport* transport)
+topics::StereoCalibrationMsg ToCalibrationMsg(const estimator::vo::CameraModel& cam0,
+                                              const estimator::vo::CameraModel& cam1) {
+  topics::StereoCalibrationMsg m;
+  m.cam0 = ToCameraMsg(cam0);
+  m.cam1 = ToCameraMsg(cam1);
+  return m;
+}
+
+MapdLink::MapdLink(ipc::Transport* transport,
+                   const std::optional<topics::StereoCalibrationMsg>& calibration)
     : poses_(MakePublisher<topics::PoseMsg>(transport, topics::kPoseTopic)),
       frames_(MakePublisher<topics::StereoFrameMsg>(transport, topics::kStereoFrameTopic)),
       switches_(MakePublisher<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic)),
@@ -52,6 +75,14 @@ MapdLink::MapdLink(ipc::Transport* transport)
   if (requests_ == nullptr) {
     throw std::runtime_error("mapd link: cannot subscribe to " +
                              std::string(topics::kFrameSwitchRequestTopic) + ": " + error);
+  }
+  if (calibration) {
+    calibration_ = MakePublisher<topics::StereoCalibrationMsg>(
+        transport, topics::kStereoCalibrationTopic, {.history_capacity = 1});
+    if (!calibration_->Publish(*calibration)) {
+      throw std::runtime_error("mapd link: cannot publish the stereo calibration on " +
+                               std::string(topics::kStereoCalibrationTopic));
+    }
   }
 }
 

@@ -15,10 +15,12 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "core/ipc/transport.h"
 #include "core/log/msgs/diagnostic_msgs.h"
 #include "drivers/camera/stereo_frame.h"
+#include "estimator/vo/stereo_rectifier.h"
 #include "firmware/roverd/estimator_loop.h"
 #include "firmware/runtime/topics/rover_topics.h"
 
@@ -37,9 +39,12 @@ struct MapdLinkStats {
 
 class MapdLink final : public EstimatorListener {
  public:
-  /// Creates the endpoints on `transport` (start-up: allocates). Throws
-  /// std::runtime_error naming the topic the transport refused.
-  explicit MapdLink(ipc::Transport* transport);
+  /// Creates the endpoints on `transport` (start-up: allocates) and, given
+  /// the stereo head's calibration, publishes it once with history so that
+  /// mapd receives it whenever it connects. Throws std::runtime_error naming
+  /// the topic the transport refused.
+  explicit MapdLink(ipc::Transport* transport,
+                    const std::optional<runtime::topics::StereoCalibrationMsg>& calibration = {});
 
   // EstimatorListener, IMU thread.
   void OnState(const estimator::EskfOutput& output) override;
@@ -68,12 +73,17 @@ class MapdLink final : public EstimatorListener {
   std::unique_ptr<ipc::Publisher<runtime::topics::StereoFrameMsg>> frames_;
   std::unique_ptr<ipc::Publisher<runtime::topics::FrameSwitchMsg>> switches_;
   std::unique_ptr<ipc::Publisher<runtime::topics::DiagnosticsMsg>> diagnostics_;
+  std::unique_ptr<ipc::Publisher<runtime::topics::StereoCalibrationMsg>> calibration_;
   std::unique_ptr<ipc::Subscriber<runtime::topics::FrameSwitchRequestMsg>> requests_;
   std::atomic<int64_t> latest_stamp_ns_{0};
   std::atomic<uint64_t> requests_handed_{0};
   std::atomic<uint64_t> requests_refused_{0};
   std::atomic<uint64_t> oversized_frames_{0};
 };
+
+/// The calibration message of a stereo head.
+runtime::topics::StereoCalibrationMsg ToCalibrationMsg(const estimator::vo::CameraModel& cam0,
+                                                       const estimator::vo::CameraModel& cam1);
 
 /// Forwards the estimator's outputs to two listeners (either may be null).
 class ListenerPair final : public EstimatorListener {

@@ -49,7 +49,11 @@ RoverdProcess::RoverdProcess(const RoverdOptions& roverd_options, const RoverdDr
         {.runtime_name = options_.ipc_runtime_name, .roudi_wait_timeout = options_.roudi_wait},
         &error);
     if (transport_ == nullptr) throw std::runtime_error(error);
-    mapd_link_.emplace(transport_.get());
+    std::optional<runtime::topics::StereoCalibrationMsg> calibration;
+    if (roverd_options.camera) {
+      calibration = ToCalibrationMsg(roverd_options.camera->cam0, roverd_options.camera->cam1);
+    }
+    mapd_link_.emplace(transport_.get(), calibration);
   }
   roverd_ = std::make_unique<Roverd>(roverd_options, drivers, channels,
                                      RoverdOutputs{.listener = listener,

@@ -169,6 +169,10 @@ Problem FindProblem(const BoardConfig& c) {
                              BoardMapdOptions::kMaxRestartBackoffS, false, "a backoff (s)")) {
     return p;
   }
+  if (Problem p = CheckRange("mapd.mapping_rate_hz", c.mapd.mapping_rate_hz, 0.0,
+                             BoardMapdOptions::kMaxMappingRateHz, false, "a rate (Hz)")) {
+    return p;
+  }
   return std::nullopt;
 }
 
@@ -309,6 +313,8 @@ BoardConfig BoardConfig::Load(const ConfigNode& root) {
     c.mapd.submap_max_position_sigma_m =
         mapd.Get<double>("submap_max_position_sigma_m", c.mapd.submap_max_position_sigma_m);
     c.mapd.restart_backoff_s = mapd.Get<double>("restart_backoff_s", c.mapd.restart_backoff_s);
+    c.mapd.mapping = mapd.Get<bool>("mapping", c.mapd.mapping);
+    c.mapd.mapping_rate_hz = mapd.Get<double>("mapping_rate_hz", c.mapd.mapping_rate_hz);
   }
 
   if (Problem p = FindProblem(c)) FailAt(root, p->first, p->second);

@@ -20,7 +20,7 @@
 //   ipc: {roudi_wait_s: 5.0}
 //   health: {period_s: 1.0, stale_after_s: 1.0, rate_warn_fraction: 0.9, watchdog: true}
 //   mapd: {submap_max_distance_m: 7.0, submap_max_position_sigma_m: 0.1,
-//          restart_backoff_s: 1.0}
+//          restart_backoff_s: 1.0, mapping: true, mapping_rate_hz: 2.0}
 //
 // Every section except `board` and `log` is optional and every key in an
 // optional section defaults to the value shown. Unknown keys are errors.
@@ -138,6 +138,12 @@ struct BoardMapdOptions {
   double submap_max_position_sigma_m = 0.1;
   /// Wait before reconnecting / restarting after a failure, s.
   double restart_backoff_s = 1.0;
+  /// Map the stereo pairs (depth, obstacles, submap voxels and clouds).
+  bool mapping = true;
+  /// At most this many pairs mapped per second of capture time (0: as many
+  /// as mapd keeps up with).
+  double mapping_rate_hz = 2.0;
+  static constexpr double kMaxMappingRateHz = 1000.0;
 };
 
 /// The whole board profile.

@@ -32,6 +32,7 @@ inline constexpr std::string_view kFrameSwitchTopic = "/roverd/frame_switch";
 inline constexpr std::string_view kFrameSwitchRequestTopic = "/mapd/frame_switch_request";
 inline constexpr std::string_view kMapdStatusTopic = "/mapd/status";
 inline constexpr std::string_view kDiagnosticsTopic = "/roverd/diagnostics";
+inline constexpr std::string_view kStereoCalibrationTopic = "/roverd/stereo_calibration";
 
 /// One estimate of the local reference filter, in its current local frame.
 struct PoseMsg {
@@ -127,6 +128,27 @@ struct DiagnosticsMsg {
   uint32_t version = kTopicsVersion;
   uint32_t cdr_size = 0;
   std::array<std::byte, kMaxCdrBytes> cdr;
+};
+
+/// One camera's calibration as roverd uses it: pinhole with radial-tangential
+/// distortion, and its pose on the body (the IMU).
+struct CameraCalibrationMsg {
+  int32_t width_px = 0;
+  int32_t height_px = 0;
+  std::array<double, 4> intrinsics{};  ///< fu, fv, cu, cv [px]
+  std::array<double, 4> distortion{};  ///< k1, k2, p1, p2
+  std::array<double, 3> p_body_cam_m{};
+  std::array<double, 4> q_body_cam_wxyz{1.0, 0.0, 0.0, 0.0};
+};
+
+/// The stereo head's calibration, published once by roverd with history so
+/// that a (re)started mapd receives it on connecting: mapd rectifies the
+/// pairs of /roverd/stereo_frame with it.
+struct StereoCalibrationMsg {
+  uint32_t version = kTopicsVersion;
+  uint32_t reserved = 0;
+  CameraCalibrationMsg cam0;
+  CameraCalibrationMsg cam1;
 };
 
 }  // namespace rover::runtime::topics

@@ -1,0 +1,118 @@
+#include "firmware/mapd/submap_archive.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "core/log/msgs/rover_msgs.h"
+#include "firmware/mapd/mapd.h"
+#include "mapping/compose/map_export.h"
+#include "mapping/submap/submap_messages.h"
+
+namespace rover::mapd {
+namespace {
+
+// The switch record as a transform: the new frame seen from the old one
+// (x, y, z, yaw; frames stay gravity-aligned).
+Eigen::Isometry3d TransformOf(const runtime::topics::FrameSwitchMsg& r) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(r.yaw_old_new_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(r.p_old_new_m[0], r.p_old_new_m[1], r.p_old_new_m[2]);
+  return T;
+}
+
+}  // namespace
+
+SubmapArchive::SubmapArchive(const std::string& log_stem, const std::string& robot_name,
+                             const mapping::MapComposerOptions& composer)
+    : log_stem_(log_stem), robot_name_(robot_name), composer_(composer) {
+  if (!log_stem_.empty()) {
+    log_path_ = log_stem_ + ".mcap";
+    log_ = std::make_unique<MapLog>(log_path_);
+  }
+}
+
+SubmapArchive::~SubmapArchive() = default;
+
+void SubmapArchive::OpenFrame(const SubmapRecord& record) {
+  if (T_map_frame_.empty()) {
+    T_map_frame_[record.frame_id] = Eigen::Isometry3d::Identity();
+    return;
+  }
+  if (!record.origin) return;  // joined half-way: cannot be placed
+  const auto previous = T_map_frame_.find(record.origin->old_frame_id);
+  if (previous == T_map_frame_.end()) return;
+  T_map_frame_[record.frame_id] = previous->second * TransformOf(*record.origin);
+}
+
+ArchivedBytes SubmapArchive::Add(const SubmapRecord& record, const mapping::Submap& submap) {
+  ArchivedBytes bytes;
+  log::std_msgs::Header header;
+  header.stamp = log::ToRosTime(record.last_stamp);
+  header.frame_id =
+      log::FrameId::Truncated("local/" + robot_name_ + "/" + std::to_string(submap.frame_id()));
+  const log::octomap_msgs::Octomap octomap = mapping::ToOctomapMsg(submap.octree(), header);
+  auto cloud = std::make_shared<const mapping::PointCloud>(submap.cloud());
+  const log::sensor_msgs::PointCloud2 points = mapping::ToPointCloud2(*cloud, header);
+  bytes.octree = log::SerializedSize(octomap);
+  bytes.cloud = log::SerializedSize(points);
+
+  if (log_) {
+    log::rover_msgs::SubmapInfo info;
+    info.header = header;
+    info.index = record.index;
+    info.frame_id = record.frame_id;
+    if (record.origin) {
+      info.has_origin = true;
+      info.previous_frame_id = record.origin->old_frame_id;
+      info.origin_stamp_ns = record.origin->stamp_ns;
+      info.p_previous_origin_m = record.origin->p_old_new_m;
+      info.yaw_previous_origin_rad = record.origin->yaw_old_new_rad;
+      info.origin_covariance = record.origin->covariance;
+    }
+    info.first_stamp_ns = record.first_stamp.nanoseconds();
+    info.last_stamp_ns = record.last_stamp.nanoseconds();
+    info.images = static_cast<uint32_t>(submap.images());
+    info.distance_m = record.distance_m;
+    info.octree_bytes = bytes.octree;
+    info.cloud_bytes = bytes.cloud;
+    const int64_t t = record.last_stamp.nanoseconds();
+    log_->Write("/mapd/submap/info", t, info);
+    log_->Write("/mapd/submap/octomap", t, octomap);
+    log_->Write("/mapd/submap/cloud", t, points);
+    log_->Flush();  // a crash from here on keeps this submap
+  }
+
+  // The origin may have arrived after the record was opened (topics are not
+  // ordered): chain it now.
+  if (T_map_frame_.count(record.frame_id) == 0) OpenFrame(record);
+  const auto placed = T_map_frame_.find(record.frame_id);
+  if (placed == T_map_frame_.end()) {
+    ++unplaced_;
+    return bytes;
+  }
+  composer_.SetSubmap(record.index, std::make_shared<const octomap::OcTree>(submap.octree()), cloud,
+                      placed->second);
+  return bytes;
+}
+
+void SubmapArchive::LogTraversability(const log::nav_msgs::OccupancyGrid& grid) {
+  if (!log_) return;
+  log_->Write("/mapd/traversability", log::FromRosTime(grid.header.stamp).nanoseconds(), grid);
+}
+
+void SubmapArchive::Close(const std::map<std::string, std::string>& statistics) {
+  if (closed_) return;
+  closed_ = true;
+  if (!log_) return;
+  log_->WriteMetadata("mapd_statistics", statistics);
+  log_->Close();
+  if (T_map_frame_.empty()) return;
+  // The global map in the first submap's frame.
+  const octomap::OcTree& map = composer_.Compose();
+  mapping::WriteOctreeBt(map, log_stem_ + ".bt");
+  mapping::WriteOctreeOt(map, log_stem_ + ".ot");
+  mapping::WritePly(composer_.ComposedCloud(), log_stem_ + ".ply");
+}
+
+}  // namespace rover::mapd

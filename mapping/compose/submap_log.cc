@@ -1,0 +1,161 @@
+#include "mapping/compose/submap_log.h"
+
+#include <stdexcept>
+
+#include "core/log/mcap/mcap_reader.h"
+#include "core/log/msgs/estimator_msgs.h"
+#include "core/log/msgs/message_traits.h"
+#include "core/log/msgs/octomap_msgs.h"
+#include "core/log/msgs/sensor_msgs.h"
+#include "mapping/submap/submap_messages.h"
+
+namespace rover::mapping {
+namespace {
+
+// Submap messages share one header: (stamp, frame id).
+struct HeaderKey {
+  int64_t stamp_ns = 0;
+  std::string frame_id;
+  auto operator<=>(const HeaderKey&) const = default;
+};
+
+HeaderKey KeyOf(const log::std_msgs::Header& h) {
+  return {log::FromRosTime(h.stamp).nanoseconds(), std::string(h.frame_id.view())};
+}
+
+std::string Where(const std::string& topic, uint64_t log_time) {
+  return topic + " at " + std::to_string(static_cast<double>(log_time) * 1e-9) + " s";
+}
+
+log::McapReader OpenLog(const std::string& path) {
+  try {
+    return log::McapReader::Open(path);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": not a readable MCAP log: " + e.what());
+  }
+}
+
+Eigen::Isometry3d SwitchTransform(const log::rover_msgs::EstimatorFrameSwitch& s) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(s.yaw_old_new_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(s.p_old_new_m[0], s.p_old_new_m[1], s.p_old_new_m[2]);
+  return T;
+}
+
+}  // namespace
+
+SubmapLog ReadSubmapLog(const std::string& path) {
+  log::McapReader reader = OpenLog(path);
+  std::map<uint16_t, std::string> topics;
+  for (const auto& [id, channel] : reader.channels()) topics[id] = channel.topic;
+  SubmapLog out;
+  std::map<HeaderKey, log::rover_msgs::SubmapInfo> infos;
+  std::map<HeaderKey, std::shared_ptr<const octomap::OcTree>> trees;
+  std::map<HeaderKey, std::shared_ptr<const PointCloud>> clouds;
+  std::vector<HeaderKey> order;
+  reader.ForEachMessage([&](const log::MessageView& m) {
+    const std::string& topic = topics[m.channel_id];
+    std::string error;
+    try {
+      if (topic == kSubmapInfoTopic) {
+        log::rover_msgs::SubmapInfo info;
+        if (log::DeserializeMessage(m.data, &info, &error)) {
+          const HeaderKey key = KeyOf(info.header);
+          if (infos.emplace(key, info).second) order.push_back(key);
+        }
+      } else if (topic == kSubmapOctomapTopic) {
+        log::octomap_msgs::Octomap msg;
+        if (log::DeserializeMessage(m.data, &msg, &error)) {
+          trees[KeyOf(msg.header)] = FromOctomapMsg(msg);
+        }
+      } else if (topic == kSubmapCloudTopic) {
+        log::sensor_msgs::PointCloud2 msg;
+        if (log::DeserializeMessage(m.data, &msg, &error)) {
+          clouds[KeyOf(msg.header)] = std::make_shared<const PointCloud>(FromPointCloud2(msg));
+        }
+      } else if (topic == kTraversabilityTopic) {
+        ++out.traversability_grids;
+      }
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    if (!error.empty()) out.problems.push_back(Where(topic, m.log_time) + ": " + error);
+    return true;
+  });
+  for (const log::Damage& d : reader.damage()) {
+    out.problems.push_back(path + ": damaged at byte " + std::to_string(d.offset) + ": " + d.what);
+  }
+  for (const HeaderKey& key : order) {
+    LoggedSubmap s;
+    s.info = infos[key];
+    const auto tree = trees.find(key);
+    const auto cloud = clouds.find(key);
+    if (tree == trees.end() || cloud == clouds.end()) {
+      out.problems.push_back("submap " + std::to_string(s.info.index) + " (" + key.frame_id +
+                             "): its " + (tree == trees.end() ? "octree" : "cloud") +
+                             " message is missing");
+      continue;
+    }
+    s.octree = tree->second;
+    s.cloud = cloud->second;
+    out.submaps.push_back(std::move(s));
+  }
+  for (const log::Metadata& m : reader.metadata()) {
+    if (m.name == "mapd_statistics") out.statistics = m.metadata;
+  }
+  return out;
+}
+
+std::map<uint32_t, Eigen::Isometry3d> ReadFrameOrigins(const std::string& roverd_log_path) {
+  log::McapReader reader = OpenLog(roverd_log_path);
+  std::map<uint16_t, bool> is_switch;
+  for (const auto& [id, channel] : reader.channels()) {
+    is_switch[id] = channel.topic == "/estimator/frame_switch_record";
+  }
+  std::map<uint32_t, Eigen::Isometry3d> origins = {{0u, Eigen::Isometry3d::Identity()}};
+  std::string problem;
+  log::ReadOptions in_time_order;
+  in_time_order.order = log::ReadOptions::Order::kLogTime;
+  reader.ForEachMessage(
+      [&](const log::MessageView& m) {
+        if (!is_switch[m.channel_id]) return true;
+        log::rover_msgs::EstimatorFrameSwitch s;
+        std::string error;
+        if (!log::DeserializeMessage(m.data, &s, &error)) {
+          problem = "a frame switch record does not decode: " + error;
+          return false;
+        }
+        const auto old_frame = origins.find(s.old_frame_id);
+        if (old_frame == origins.end()) {
+          problem = "the switch " + std::to_string(s.old_frame_id) + " -> " +
+                    std::to_string(s.new_frame_id) + " starts in a frame never reached";
+          return false;
+        }
+        origins[s.new_frame_id] = old_frame->second * SwitchTransform(s);
+        return true;
+      },
+      in_time_order);
+  if (!problem.empty()) throw std::runtime_error(roverd_log_path + ": " + problem);
+  return origins;
+}
+
+std::size_t AddLoggedSubmaps(const std::vector<SubmapLog>& logs,
+                             const std::map<uint32_t, Eigen::Isometry3d>& origins,
+                             MapComposer* composer) {
+  std::size_t unplaced = 0;
+  // Ids in log order, then submap order: composition order is id order.
+  uint32_t id = 0;
+  for (const SubmapLog& l : logs) {
+    for (const LoggedSubmap& s : l.submaps) {
+      const auto origin = origins.find(s.info.frame_id);
+      if (origin == origins.end()) {
+        ++unplaced;
+        continue;
+      }
+      composer->SetSubmap(id++, s.octree, s.cloud, origin->second);
+    }
+  }
+  return unplaced;
+}
+
+}  // namespace rover::mapping

@@ -1,0 +1,190 @@
+// mapd's mapping end to end over the in-process transport: roverd's
+// calibration, estimates, switches and analytically rendered stereo pairs
+// in; submaps (octree, cloud, obstacle flags) logged, the traversability
+// grid logged, the global map exported.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <octomap/OcTree.h>
+
+#include "core/ipc/in_process_transport.h"
+#include "firmware/mapd/mapd.h"
+#include "firmware/roverd/mapd_link.h"
+#include "mapping/compose/map_export.h"
+#include "mapping/compose/submap_log.h"
+#include "tests/firmware/mapd/stereo_scene.h"
+
+namespace rover::mapd {
+namespace {
+
+namespace topics = runtime::topics;
+
+ipc::Topic T(std::string_view name) { return *ipc::Topic::Parse(name); }
+
+class MapdMappingTest : public ::testing::Test {
+ protected:
+  MapdMappingTest() : transport_(ipc::InProcessTransport::Options{.max_queue_capacity = 8}) {
+    dir_ = std::filesystem::path(::testing::TempDir()) /
+           ("mapd_mapping_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    // roverd's side: publishes the calibration (with history) at start.
+    calibration_ = transport_.MakePublisher<topics::StereoCalibrationMsg>(
+        T(topics::kStereoCalibrationTopic), {.history_capacity = 1});
+    EXPECT_TRUE(
+        calibration_->Publish(roverd::ToCalibrationMsg(scene_.Camera(0), scene_.Camera(1))));
+    poses_ = transport_.MakePublisher<topics::PoseMsg>(T(topics::kPoseTopic));
+    switches_ = transport_.MakePublisher<topics::FrameSwitchMsg>(T(topics::kFrameSwitchTopic));
+    frames_ = transport_.MakePublisher<topics::StereoFrameMsg>(T(topics::kStereoFrameTopic));
+  }
+
+  std::unique_ptr<Mapd> MakeMapd() {
+    MapdOptions options;
+    options.pose_queue = 8;
+    options.max_mapping_rate_hz = 0.0;
+    options.output_stem = (dir_ / "mapd-test").string();
+    options.robot_name = "r1";
+    return std::make_unique<Mapd>(options, &transport_);
+  }
+
+  /// An estimate at `t_s` in `frame`, body at (x, 0, 0) of that frame.
+  void Pose(Mapd* mapd, double t_s, uint32_t frame, double x_m) {
+    topics::PoseMsg m;
+    m.stamp_ns = Time::FromSeconds(t_s).nanoseconds();
+    m.frame_id = frame;
+    m.p_local_body_m = {x_m, 0.0, 0.0};
+    m.position_sigma_m = 0.01;
+    ASSERT_TRUE(poses_->Publish(m));
+    mapd->Poll();
+  }
+
+  /// A pair captured at `t_s` with the body at world x `world_x_m`.
+  void Frame(Mapd* mapd, double t_s, double world_x_m, uint64_t sequence, int width_px = 0) {
+    auto m = std::make_unique<topics::StereoFrameMsg>();
+    m->width_px = static_cast<uint32_t>(width_px > 0 ? width_px : scene_.width_px);
+    m->height_px = static_cast<uint32_t>(scene_.height_px);
+    m->capture_stamp_ns = Time::FromSeconds(t_s).nanoseconds();
+    m->sequence = sequence;
+    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    T_world_body.translation().x() = world_x_m;
+    scene_.Render(0, T_world_body, m->cam0.data());
+    scene_.Render(1, T_world_body, m->cam1.data());
+    ASSERT_TRUE(frames_->Publish(*m));
+    mapd->Poll();
+  }
+
+  void Switch(Mapd* mapd, double t_s, uint32_t old_frame, double dx_m) {
+    topics::FrameSwitchMsg sw;
+    sw.old_frame_id = old_frame;
+    sw.new_frame_id = old_frame + 1;
+    sw.stamp_ns = Time::FromSeconds(t_s).nanoseconds();
+    sw.p_old_new_m = {dx_m, 0.0, 0.0};
+    ASSERT_TRUE(switches_->Publish(sw));
+    mapd->Poll();
+  }
+
+  testing::StereoScene scene_;
+  ipc::InProcessTransport transport_;
+  std::filesystem::path dir_;
+  std::unique_ptr<ipc::Publisher<topics::StereoCalibrationMsg>> calibration_;
+  std::unique_ptr<ipc::Publisher<topics::PoseMsg>> poses_;
+  std::unique_ptr<ipc::Publisher<topics::FrameSwitchMsg>> switches_;
+  std::unique_ptr<ipc::Publisher<topics::StereoFrameMsg>> frames_;
+};
+
+// Occupied leaves of `tree` within `tol_m` of height z (after placing by T).
+double FractionNear(const octomap::OcTree& tree, double z_m, double tol_m) {
+  int near = 0;
+  int all = 0;
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    ++all;
+    if (std::abs(it.getZ() - z_m) <= tol_m) ++near;
+  }
+  return all > 0 ? static_cast<double>(near) / all : 0.0;
+}
+
+TEST_F(MapdMappingTest, MapsPairsIntoSubmapsLogsThemAndExportsTheGlobalMap) {
+  auto mapd = MakeMapd();
+  // Frame 0: the body stands at world x = 0.
+  for (int i = 0; i <= 10; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
+  Frame(mapd.get(), 1.05, 0.0, 1);
+  for (int i = 11; i <= 20; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
+  EXPECT_EQ(mapd->stats().images_mapped, 1u) << "mapped once its estimates arrived";
+  // The switch mapd asked for at start: frame 1 has its origin 0.5 m ahead,
+  // so the same body position is x = -0.5 there.
+  Switch(mapd.get(), 1.2, 0, 0.5);
+  for (int i = 21; i <= 40; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 1, -0.5);
+  Frame(mapd.get(), 1.30, 0.0, 3);
+  for (int i = 41; i <= 50; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 1, -0.5);
+  EXPECT_EQ(mapd->stats().images_mapped, 2u);
+  EXPECT_EQ(mapd->stats().submaps_archived, 1u) << "frame 0's submap ends when frame 1 begins";
+  mapd->Shutdown();
+  EXPECT_EQ(mapd->stats().submaps_archived, 2u);
+  EXPECT_GT(mapd->stats().obstacle_points, 50u) << "the box is a step obstacle";
+
+  // The log: both submaps, with their octree and cloud, and grids.
+  const mapping::SubmapLog log = mapping::ReadSubmapLog(mapd->log_path());
+  EXPECT_TRUE(log.problems.empty()) << log.problems.front();
+  ASSERT_EQ(log.submaps.size(), 2u);
+  EXPECT_EQ(log.submaps[1].info.frame_id, 1u);
+  EXPECT_TRUE(log.submaps[1].info.has_origin);
+  EXPECT_DOUBLE_EQ(log.submaps[1].info.p_previous_origin_m[0], 0.5);
+  EXPECT_EQ(std::string(log.submaps[1].info.header.frame_id.view()), "local/r1/1");
+  EXPECT_GT(log.submaps[0].info.octree_bytes, 0u);
+  EXPECT_GT(log.submaps[0].info.cloud_bytes, 0u);
+  EXPECT_EQ(log.statistics.at("submaps"), "2");
+  EXPECT_GE(log.traversability_grids, 1u);
+  for (const mapping::LoggedSubmap& s : log.submaps) {
+    // Ground voxels sit at the plane (10 cm voxels: centres within 0.1 m);
+    // the box adds a few above it.
+    EXPECT_GT(FractionNear(*s.octree, scene_.ground_z_m, 0.1), 0.8) << s.info.index;
+    int obstacles_on_box = 0;
+    int obstacles_elsewhere = 0;
+    const double box_x_in_frame = s.info.frame_id == 0 ? 0.0 : -0.5;
+    for (const mapping::CloudPoint& p : *s.cloud) {
+      if (!p.obstacle) continue;
+      const double x = static_cast<double>(p.p_submap_m.x()) - box_x_in_frame;
+      const bool near_box = x > scene_.box_min_xy.x() - 0.35 && x < scene_.box_max_xy.x() + 0.35 &&
+                            std::abs(static_cast<double>(p.p_submap_m.y())) < 0.65;
+      (near_box ? obstacles_on_box : obstacles_elsewhere)++;
+    }
+    EXPECT_GT(obstacles_on_box, 20) << s.info.index;
+    EXPECT_LT(obstacles_elsewhere, obstacles_on_box / 5) << s.info.index;
+  }
+
+  // The exported global map is in frame 0: frame 1's submap is placed by
+  // the switch, so both see the ground at the same height and the box at
+  // the same place.
+  octomap::OcTree exported(0.1);
+  ASSERT_TRUE(exported.readBinary(mapd->log_path().substr(0, mapd->log_path().size() - 5) + ".bt"));
+  EXPECT_GT(exported.getNumLeafNodes(), 100u);
+  EXPECT_GT(FractionNear(exported, scene_.ground_z_m, 0.1), 0.8);
+  const mapping::PointCloud cloud =
+      mapping::ReadPly(mapd->log_path().substr(0, mapd->log_path().size() - 5) + ".ply");
+  EXPECT_GT(cloud.size(), 1000u);
+}
+
+TEST_F(MapdMappingTest, APairOfTheWrongSizeIsCountedAndMappingGoesOn) {
+  auto mapd = MakeMapd();
+  for (int i = 0; i <= 20; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
+  Frame(mapd.get(), 1.05, 0.0, 1, scene_.width_px - 8);
+  EXPECT_EQ(mapd->stats().images_failed, 1u);
+  Frame(mapd.get(), 1.15, 0.0, 2);
+  EXPECT_EQ(mapd->stats().images_mapped, 1u);
+}
+
+TEST_F(MapdMappingTest, APairWithoutEstimatesAroundItIsNotPlaced) {
+  auto mapd = MakeMapd();
+  for (int i = 0; i <= 20; ++i) Pose(mapd.get(), 2.0 + 0.01 * i, 0, 0.0);
+  Frame(mapd.get(), 1.5, 0.0, 1);  // older than every estimate mapd kept
+  EXPECT_EQ(mapd->stats().images_unplaced, 1u);
+  EXPECT_EQ(mapd->stats().images_mapped, 0u);
+}
+
+}  // namespace
+}  // namespace rover::mapd
