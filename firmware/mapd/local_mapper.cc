@@ -1,6 +1,9 @@
 #include "firmware/mapd/local_mapper.h"
 
 #include <chrono>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -41,6 +44,11 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 void LocalMapperOptions::Validate() const {
   disparity.Validate();
   depth.Validate();
+  if (!(obstacle_closing_radius_m >= 0.0) || obstacle_closing_radius_m > 2.0) {
+    throw std::invalid_argument(
+        "LocalMapperOptions.obstacle_closing_radius_m: expected 0..2 m, got " +
+        std::to_string(obstacle_closing_radius_m));
+  }
   if (!(pixel_error_px > 0.0)) {
     throw std::invalid_argument("LocalMapperOptions.pixel_error_px: expected > 0, got " +
                                 std::to_string(pixel_error_px));
@@ -110,6 +118,18 @@ int LocalMapper::MarkObstacles(const mapping::StepGrid& steps,
   const int h = depth_.height();
   obstacle_mask_.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
   int flagged = 0;
+  step_obstacles_.create(steps.rows, steps.cols, CV_8UC1);
+  for (int iy = 0; iy < steps.rows; ++iy) {
+    uint8_t* row = step_obstacles_.ptr<uint8_t>(iy);
+    for (int ix = 0; ix < steps.cols; ++ix) row[ix] = steps.Obstacle(ix, iy) ? 255 : 0;
+  }
+  const int radius =
+      static_cast<int>(std::lround(options_.obstacle_closing_radius_m / steps.resolution_m));
+  if (radius > 0) {
+    const cv::Mat disc =
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+    cv::morphologyEx(step_obstacles_, step_obstacles_, cv::MORPH_CLOSE, disc);
+  }
   const Eigen::Isometry3f T = T_local_cam.cast<float>();
   const auto res = static_cast<float>(steps.resolution_m);
   const Eigen::Vector2f origin = steps.origin_xy.cast<float>();
@@ -120,7 +140,7 @@ int LocalMapper::MarkObstacles(const mapping::StepGrid& steps,
       const auto ix = static_cast<int>(std::floor((p.x() - origin.x()) / res));
       const auto iy = static_cast<int>(std::floor((p.y() - origin.y()) / res));
       if (ix < 0 || iy < 0 || ix >= steps.cols || iy >= steps.rows) continue;
-      if (!steps.Obstacle(ix, iy)) continue;
+      if (step_obstacles_.at<uint8_t>(iy, ix) == 0) continue;
       obstacle_mask_[static_cast<std::size_t>(v) * static_cast<std::size_t>(w) +
                      static_cast<std::size_t>(u)] = 1;
       ++flagged;

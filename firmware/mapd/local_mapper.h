@@ -34,6 +34,11 @@ struct LocalMapperOptions {
   mapping::StepClassifierOptions steps;
   mapping::NegativeEdgeOptions negative_edges;
   mapping::TraversabilityGridOptions traversability;
+  /// Obstacle cells of the step grid are closed (dilated, then eroded) with
+  /// a disc of this radius: a rock's flat top, which no window of the step
+  /// test spans, lies inside the ring its edges flag and is as impassable.
+  /// 0 disables it.
+  double obstacle_closing_radius_m = 0.25;
 
   /// Throws std::invalid_argument naming the component and key.
   void Validate() const;
@@ -71,6 +76,8 @@ class LocalMapper {
   const Eigen::Isometry3d& T_body_cam() const { return T_body_cam_; }
   /// The latest depth image (for tests and tools).
   const mapping::DepthImage* last_depth() const { return has_depth_ ? &depth_ : nullptr; }
+  /// The latest image's obstacle flags per pixel (row-major, 1: obstacle).
+  const std::vector<uint8_t>& last_obstacle_mask() const { return obstacle_mask_; }
 
  private:
   /// Per-pixel obstacle flags of the valid points: on a step obstacle cell or
@@ -91,6 +98,7 @@ class LocalMapper {
   mapping::DepthImage depth_;
   bool has_depth_ = false;
   std::vector<uint8_t> obstacle_mask_;
+  cv::Mat step_obstacles_;  ///< CV_8U over the step grid, closed
 };
 
 }  // namespace rover::mapd

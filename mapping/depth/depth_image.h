@@ -31,8 +31,13 @@ struct DepthImageOptions {
   /// Disparities below this (px) count as infinitely far. SGBM resolves
   /// 1/16 px; below about half a pixel the depth is meaningless anyway.
   double min_disparity_px = 0.5;
-  /// Thesis: 0.15 m-class limits on its cameras (Figure 5.2).
-  double max_depth_sigma_m = 0.15;
+  /// The thesis limits sigma_z to about 0.15 m on its f = 1080 px cameras,
+  /// i.e. view distances of 2.5-5 m (Figure 5.2). Its value depends on the
+  /// camera: on the simulator's head (f = 422 px rectified, b = 0.09 m)
+  /// 0.15 m would end stereo range at 2.8 m, short of the rocks the route
+  /// passes; 0.3 m reaches 4 m, and the step test's error-adaptive
+  /// threshold absorbs the larger error.
+  double max_depth_sigma_m = 0.3;
 
   /// Throws std::invalid_argument "DepthImageOptions.<key>: ...".
   void Validate() const;

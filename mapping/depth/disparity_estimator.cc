@@ -1,6 +1,10 @@
 #include "mapping/depth/disparity_estimator.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
 
 namespace rover::mapping {
 namespace {
@@ -27,6 +31,7 @@ DisparityOptions DisparityOptions::Load(const ConfigNode& node) {
   o.speckle_range_px = node.Get<int>("speckle_range_px", o.speckle_range_px);
   o.max_left_right_diff_px = node.Get<int>("max_left_right_diff_px", o.max_left_right_diff_px);
   o.mode = node.Get<std::string>("mode", o.mode);
+  o.min_texture_dn = node.Get<double>("min_texture_dn", o.min_texture_dn);
   o.Validate();
   return o;
 }
@@ -49,6 +54,10 @@ void DisparityOptions::Validate() const {
   }
   if (speckle_window_px < 0) fail("speckle_window_px", ">= 0", speckle_window_px);
   if (speckle_range_px < 0) fail("speckle_range_px", ">= 0", speckle_range_px);
+  if (!(min_texture_dn >= 0.0) || !std::isfinite(min_texture_dn)) {
+    throw std::invalid_argument("DisparityOptions.min_texture_dn: expected >= 0, found " +
+                                std::to_string(min_texture_dn));
+  }
   ModeOf(mode);
 }
 
@@ -74,6 +83,26 @@ void DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& right,
                                 std::to_string(right.rows));
   }
   sgbm_->compute(left, right, *disparity_q4);
+  // The matching window runs off the image within half a block of its
+  // border: SGBM's values there (zero disparity, often) mean nothing, and
+  // must not read as "infinitely far".
+  const int margin = options_.block_size_px / 2 + 1;
+  const cv::Scalar invalid(InvalidValue());
+  disparity_q4->rowRange(0, std::min(margin, disparity_q4->rows)).setTo(invalid);
+  disparity_q4->rowRange(std::max(0, disparity_q4->rows - margin), disparity_q4->rows)
+      .setTo(invalid);
+  disparity_q4->colRange(0, std::min(margin, disparity_q4->cols)).setTo(invalid);
+  disparity_q4->colRange(std::max(0, disparity_q4->cols - margin), disparity_q4->cols)
+      .setTo(invalid);
+  if (options_.min_texture_dn > 0.0) {
+    // Mean |dI/dx| (Sobel normalised to one pixel step) over 7x7.
+    cv::Mat gradient;
+    cv::Sobel(left, gradient, CV_32F, 1, 0, 3, 1.0 / 8.0);
+    cv::Mat texture;
+    cv::boxFilter(cv::abs(gradient), texture, CV_32F, cv::Size(7, 7));
+    disparity_q4->setTo(cv::Scalar(InvalidValue()),
+                        texture < static_cast<float>(options_.min_texture_dn));
+  }
 }
 
 }  // namespace rover::mapping

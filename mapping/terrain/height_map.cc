@@ -1,5 +1,7 @@
 #include "mapping/terrain/height_map.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -14,6 +16,13 @@ void HeightMapOptions::Validate() const {
   if (!(std::isfinite(half_extent_m) && half_extent_m >= resolution_m)) {
     throw std::invalid_argument("HeightMapOptions.half_extent_m: expected >= resolution_m, found " +
                                 std::to_string(half_extent_m));
+  }
+  if (!(spike_tolerance_m >= 0.0)) {
+    throw std::invalid_argument("HeightMapOptions.spike_tolerance_m: expected >= 0, found " +
+                                std::to_string(spike_tolerance_m));
+  }
+  if (min_points < 1) {
+    throw std::invalid_argument("HeightMapOptions.min_points: expected >= 1, found 0");
   }
 }
 
@@ -31,6 +40,7 @@ HeightMap HeightMap::Build(const DepthImage& depth, const Eigen::Isometry3d& T_g
   options.Validate();
   HeightMap map;
   map.resolution_m_ = options.resolution_m;
+  map.min_points_ = options.min_points;
   const int half_cells = static_cast<int>(std::ceil(options.half_extent_m / options.resolution_m));
   map.cols_ = map.rows_ = 2 * half_cells;
   // Cell borders on multiples of the resolution, so that maps of
@@ -54,7 +64,40 @@ HeightMap HeightMap::Build(const DepthImage& depth, const Eigen::Isometry3d& T_g
       map.heights_[i] += (p.z() - map.heights_[i]) / map.counts_[i];
     }
   }
+  if (options.spike_tolerance_m > 0.0) map.RemoveSpikes(options.spike_tolerance_m);
   return map;
+}
+
+void HeightMap::RemoveSpikes(double tolerance_m) {
+  std::vector<std::size_t> spikes;
+  std::array<double, 8> neighbours{};
+  for (int iy = 0; iy < rows_; ++iy) {
+    for (int ix = 0; ix < cols_; ++ix) {
+      if (!Has(ix, iy)) continue;
+      const double h = height(ix, iy);
+      std::size_t n = 0;
+      int agree = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = ix + dx;
+          const int y = iy + dy;
+          if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= cols_ || y >= rows_ || !Has(x, y)) {
+            continue;
+          }
+          neighbours[n++] = height(x, y);
+          if (std::abs(height(x, y) - h) <= tolerance_m) ++agree;
+        }
+      }
+      if (n < 3 || agree >= 2) continue;
+      const auto mid = neighbours.begin() + static_cast<std::ptrdiff_t>(n / 2);
+      std::nth_element(neighbours.begin(), mid,
+                       neighbours.begin() + static_cast<std::ptrdiff_t>(n));
+      if (std::abs(h - *mid) > tolerance_m) spikes.push_back(Index(ix, iy));
+    }
+  }
+  // Judged on the unfiltered map, removed together: removing one spike
+  // must not change the verdict on its neighbours.
+  for (const std::size_t i : spikes) counts_[i] = 0;
 }
 
 }  // namespace rover::mapping

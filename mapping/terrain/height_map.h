@@ -20,6 +20,20 @@ struct HeightMapOptions {
   double resolution_m = 0.05;
   /// The grid spans +-half_extent_m around the camera in x and y.
   double half_extent_m = 6.0;
+  /// Cells with fewer points count as empty: at the far end of stereo
+  /// range a cell holds a handful of points, and one bad match among one or
+  /// two would make its mean a step that is not there.
+  uint32_t min_points = 3;
+  /// Drop spikes: a cell that lies more than `spike_tolerance_m` off the
+  /// median of its 8 neighbours (at least 3 with data) while fewer than 2
+  /// of them are within that tolerance of it. A few wrong matches that land
+  /// together in one cell (a horizon mismatch, say) float it half a metre
+  /// above its neighbours, and as a lone spike it would make a step
+  /// obstacle of every window around it. A real step edge has neighbours
+  /// at its own height along the edge, so it stays. (The thesis post-filters
+  /// small isolated obstacle hypotheses instead; the effect is the same.)
+  /// 0 disables it.
+  double spike_tolerance_m = 0.05;
 
   /// Throws std::invalid_argument "HeightMapOptions.<key>: ...".
   void Validate() const;
@@ -38,7 +52,7 @@ class HeightMap {
   /// World (gravity-frame) x, y of cell (0, 0)'s lower corner.
   const Eigen::Vector2d& origin_xy() const { return origin_xy_; }
 
-  bool Has(int ix, int iy) const { return count(ix, iy) > 0; }
+  bool Has(int ix, int iy) const { return count(ix, iy) >= min_points_; }
   uint32_t count(int ix, int iy) const { return counts_[Index(ix, iy)]; }
   /// Mean height of the cell's points (meaningful where Has()).
   double height(int ix, int iy) const { return heights_[Index(ix, iy)]; }
@@ -51,6 +65,7 @@ class HeightMap {
   bool CellOf(const Eigen::Vector3d& p, int* ix, int* iy) const;
 
  private:
+  void RemoveSpikes(double tolerance_m);
   std::size_t Index(int ix, int iy) const {
     return static_cast<std::size_t>(iy) * static_cast<std::size_t>(cols_) +
            static_cast<std::size_t>(ix);
@@ -60,6 +75,7 @@ class HeightMap {
   int rows_ = 0;
   double resolution_m_ = 0.05;
   Eigen::Vector2d origin_xy_ = Eigen::Vector2d::Zero();
+  uint32_t min_points_ = 1;
   std::vector<uint32_t> counts_;
   std::vector<double> heights_;
 };

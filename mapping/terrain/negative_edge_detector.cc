@@ -39,8 +39,10 @@ std::vector<NegativeEdge> NegativeEdgeDetector::Detect(
   const Eigen::Matrix3d& R = T_gravity_cam.linear();
   for (int u = 0; u < depth.width(); ++u) {
     for (int v = 1; v < depth.height(); ++v) {
-      const DepthState lower = depth.state(u, v);
-      if (!HasPoint(lower)) continue;
+      // The near side must be a point within the error budget (thesis: too
+      // uncertain points are left out of all later processing); the far
+      // side may be uncertain, as the ground below a cliff is far away.
+      if (depth.state(u, v) != DepthState::kValid) continue;
       const DepthState upper = depth.state(u, v - 1);
       const Eigen::Vector3d q_cam = depth.point(u, v).cast<double>();
       const Eigen::Vector3d q = T_gravity_cam * q_cam;

@@ -12,6 +12,10 @@ void StepClassifierOptions::Validate() const {
     throw std::invalid_argument("StepClassifierOptions.h_max_m: expected > 0, found " +
                                 std::to_string(h_max_m));
   }
+  if (!(std::isfinite(sigma_factor) && sigma_factor >= 0.0)) {
+    throw std::invalid_argument("StepClassifierOptions.sigma_factor: expected >= 0, found " +
+                                std::to_string(sigma_factor));
+  }
   if (window_cells < 2 || window_cells > 16) {
     throw std::invalid_argument("StepClassifierOptions.window_cells: expected 2..16, found " +
                                 std::to_string(window_cells));
@@ -61,7 +65,9 @@ StepGrid StepClassifier::Classify(const HeightMap& map,
       if (options_.error_adaptive && h_diff > 0.0) {
         const Eigen::Vector3d p = T_cam_gravity * map.CellPoint(max_x, max_y);
         const Eigen::Vector3d q = T_cam_gravity * map.CellPoint(min_x, min_y);
-        if (p.z() > 0.0 && q.z() > 0.0) threshold += model_.DistanceSigma(p, q);
+        if (p.z() > 0.0 && q.z() > 0.0) {
+          threshold += options_.sigma_factor * model_.DistanceSigma(p, q);
+        }
       }
       grid.traversability[static_cast<std::size_t>(iy) * static_cast<std::size_t>(grid.cols) +
                           static_cast<std::size_t>(ix)] = static_cast<float>(h_diff / threshold);

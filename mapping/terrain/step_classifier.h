@@ -30,6 +30,11 @@ struct StepClassifierOptions {
   int window_cells = 6;
   /// Leave Delta_d out (for comparison: what the thesis argues against).
   bool error_adaptive = true;
+  /// The threshold is h_max + sigma_factor * Delta_d; the thesis adds
+  /// Delta_d itself (1). With the height map's median filter taking out the
+  /// lone spikes of wrong matches, 1 leaves no false steps on the
+  /// simulator's level ground, and larger factors only lose far obstacles.
+  double sigma_factor = 1.0;
 
   /// Throws std::invalid_argument "StepClassifierOptions.<key>: ...".
   void Validate() const;

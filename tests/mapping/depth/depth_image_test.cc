@@ -76,6 +76,41 @@ TEST(DepthImageTest, SgbmRecoversATexturedPlane) {
   EXPECT_THROW(sgbm.Compute(left, cv::Mat(), &disparity), std::invalid_argument);
 }
 
+TEST(DisparityEstimatorTest, TexturelessRegionsAndTheBorderGetNoDisparity) {
+  // The textured plane of the test above, with a band of flat grey plus
+  // faint noise (a sky: 1 DN) across its top third.
+  const int w = 320, h = 240;
+  cv::Mat texture(h, w + 64, CV_8UC1);
+  cv::RNG rng(5);
+  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
+  cv::Mat sky = texture.rowRange(0, h / 3);
+  rng.fill(sky, cv::RNG::NORMAL, 30, 1);
+  const cv::Mat left = texture(cv::Rect(32, 0, w, h)).clone();
+  const cv::Mat right = texture(cv::Rect(52, 0, w, h)).clone();
+  const DisparityEstimator filtered({});
+  DisparityOptions unfiltered_options;
+  unfiltered_options.min_texture_dn = 0.0;
+  const DisparityEstimator unfiltered(unfiltered_options);
+  cv::Mat with, without;
+  filtered.Compute(left, right, &with);
+  unfiltered.Compute(left, right, &without);
+  const auto matched = [](const cv::Mat& d, int row0, int row1, int col0, int col1) {
+    int n = 0;
+    for (int v = row0; v < row1; ++v) {
+      for (int u = col0; u < col1; ++u) n += d.at<int16_t>(v, u) >= 0 ? 1 : 0;
+    }
+    return n;
+  };
+  EXPECT_GT(matched(without, 10, h / 3 - 10, 80, w - 10), 100) << "SGBM matches the noise";
+  EXPECT_EQ(matched(with, 10, h / 3 - 10, 80, w - 10), 0);
+  EXPECT_GT(matched(with, h / 3 + 10, h - 10, 80, w - 10), 0.95 * (h - h / 3 - 20) * (w - 90))
+      << "the textured part keeps its disparities";
+  // Half a block (5 px: 2) plus one around the border: none.
+  EXPECT_EQ(matched(with, 0, h, w - 3, w), 0);
+  EXPECT_EQ(matched(with, h - 3, h, 0, w), 0);
+}
+
 TEST(DisparityOptionsTest, RejectsBadValuesNamingThem) {
   DisparityOptions o;
   o.num_disparities_px = 60;
@@ -87,6 +122,9 @@ TEST(DisparityOptionsTest, RejectsBadValuesNamingThem) {
   }
   o = {};
   o.mode = "fast";
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+  o = {};
+  o.min_texture_dn = -1.0;
   EXPECT_THROW(o.Validate(), std::invalid_argument);
 }
 

@@ -61,9 +61,47 @@ TEST(StepClassifierTest, TheErrorAdaptiveThresholdGrowsWithDistance) {
   // noise there), a fixed one does. 1.6 m ahead both call it.
   const auto far_step = [](double x, double) { return x > 4.0 ? 0.15 : 0.0; };
   const auto near_step = [](double x, double) { return x > 1.6 ? 0.15 : 0.0; };
-  EXPECT_EQ(CountObstacles(Classify(far_step, true), 3.7, 4.3, -9, 9).first, 0);
-  EXPECT_GT(CountObstacles(Classify(far_step, false), 3.7, 4.3, -9, 9).first, 0);
+  const int adaptive_far = CountObstacles(Classify(far_step, true), 3.7, 4.3, -9, 9).first;
+  const int fixed_far = CountObstacles(Classify(far_step, false), 3.7, 4.3, -9, 9).first;
+  EXPECT_GT(fixed_far, 20);
+  // At most a stray cell where the median filter meets the end of the data.
+  EXPECT_LE(adaptive_far, 1) << "fixed threshold: " << fixed_far;
   EXPECT_GT(CountObstacles(Classify(near_step, true), 1.4, 1.8, -9, 9).first, 0);
+}
+
+TEST(HeightMapTest, SpikeRemovalDropsALoneSpikeButKeepsAStep) {
+  // Level ground with one cell's points lifted 0.5 m (wrong matches that
+  // landed together), and a real 0.15 m step further on.
+  const auto terrain = [](double x, double y) {
+    if (x > 1.5 && x < 1.55 && y > 0.0 && y < 0.05) return 0.5;
+    return x > 2.1 ? 0.15 : 0.0;
+  };
+  const auto spike_obstacles = [&](bool remove_spikes) {
+    const RectifiedStereo s = SmallHead(2);
+    const Eigen::Isometry3d T = CameraPose(1.0, 30.0);
+    const DepthImage depth =
+        DepthImage::FromDisparity(RenderDisparity(s, T, terrain), StereoErrorModel(s), {});
+    HeightMapOptions options;
+    options.spike_tolerance_m = remove_spikes ? 0.05 : 0.0;
+    const HeightMap map = HeightMap::Build(depth, T, options);
+    const StereoErrorModel model(s);
+    const StepGrid steps = StepClassifier({}, model).Classify(map, T);
+    int spike = 0, step = 0;
+    for (int iy = 0; iy < steps.rows; ++iy) {
+      for (int ix = 0; ix < steps.cols; ++ix) {
+        if (!steps.Obstacle(ix, iy)) continue;
+        const Eigen::Vector3d c = map.CellPoint(ix, iy);
+        if (c.x() > 1.2 && c.x() < 1.85 && std::abs(c.y()) < 0.35) ++spike;
+        if (c.x() > 1.95 && c.x() < 2.25) ++step;
+      }
+    }
+    return std::make_pair(spike, step);
+  };
+  const auto [spike_raw, step_raw] = spike_obstacles(false);
+  const auto [spike_removed, step_kept] = spike_obstacles(true);
+  EXPECT_GT(spike_raw, 10) << "unfiltered, the spike makes every window around it a step";
+  EXPECT_EQ(spike_removed, 0);
+  EXPECT_GT(step_kept, 0.9 * step_raw) << "the real step stays";
 }
 
 TEST(StepClassifierTest, RejectsBadOptions) {
