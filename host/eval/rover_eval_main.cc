@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "host/eval/ate_command.h"
+#include "host/eval/map_command.h"
 #include "host/eval/nees_command.h"
 #include "host/eval/sim_command.h"
 #include "host/eval/subcommand.h"
@@ -15,7 +16,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "rover-eval: evaluate estimated trajectories against ground truth, and the local\n"
       "reference filter on the simulator (sim: accuracy, nees: Monte Carlo consistency), and\n"
-      "the stereo VO with the filter on EuRoC-layout datasets (vio).\n"
+      "the stereo VO with the filter on EuRoC-layout datasets (vio), and the map of a simulated\n"
+      "mission against the simulator's ground truth (map).\n"
       "Reads TUM files, EuRoC and OpenVINS CSVs and rover flight logs (MCAP, with the\n"
       "estimator's frame switches chained). Exit status: 0 ok, 1 a check failed,\n"
       "2 bad usage or unusable input."};
@@ -24,10 +26,8 @@ int main(int argc, char** argv) {
 
   // One line per subcommand; each lives in its own *_command.{h,cc}.
   const std::vector<eval::Subcommand> subcommands = {
-      eval::AddAteCommand(app),
-      eval::AddNeesCommand(app),
-      eval::AddSimCommand(app),
-      eval::AddVioCommand(app),
+      eval::AddAteCommand(app), eval::AddMapCommand(app), eval::AddNeesCommand(app),
+      eval::AddSimCommand(app), eval::AddVioCommand(app),
   };
 
   try {

@@ -186,7 +186,10 @@ MissionResult RunMission(const MissionOptions& options) {
   process_options.log_path = result.log_path;
   process_options.metadata["mission"] = {{"scenario", options.scenario},
                                          {"seed", std::to_string(options.seed)},
-                                         {"lockstep", options.lockstep ? "true" : "false"}};
+                                         {"lockstep", options.lockstep ? "true" : "false"},
+                                         // the simulator's time origin: ground truth is
+                                         // trajectory(t - start)
+                                         {"start_ns", std::to_string(start.nanoseconds())}};
   process_options.ipc_runtime_name = options.ipc_runtime_name;
   process_options.images = options.images;
   process_options.program_name = "roverd-sim";

@@ -1,0 +1,252 @@
+#include "host/eval/map_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include "core/geometry/yaw.h"
+#include "core/log/mcap/mcap_reader.h"
+#include "core/log/msgs/estimator_msgs.h"
+#include "core/log/msgs/message_traits.h"
+#include "estimator/eskf/eskf_output.h"
+#include "hil/sim/dataset/dataset_generator.h"
+#include "hil/sim/motion/rover_trajectory.h"
+#include "hil/sim/scenario/scenario.h"
+#include "mapping/compose/map_composer.h"
+#include "mapping/compose/map_export.h"
+#include "mapping/compose/submap_log.h"
+
+namespace rover::host::eval {
+namespace {
+
+// What the mission log tells about the run.
+struct MissionFacts {
+  std::string scenario;
+  uint64_t seed = 1;
+  Time start;
+  bool has_start = false;
+  /// The first initialised estimate (frame 0): stamp and pose.
+  Time init_stamp;
+  Eigen::Isometry3d T_local0_body_init = Eigen::Isometry3d::Identity();
+  bool initialised = false;
+  Time last_stamp;
+};
+
+MissionFacts ReadMission(const std::string& path) {
+  log::McapReader reader = [&path] {
+    try {
+      return log::McapReader::Open(path);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path + ": not a readable MCAP log: " + e.what());
+    }
+  }();
+  MissionFacts f;
+  bool lockstep = true;
+  for (const log::Metadata& m : reader.metadata()) {
+    if (m.name != "mission") continue;
+    if (m.metadata.count("scenario")) f.scenario = m.metadata.at("scenario");
+    if (m.metadata.count("seed")) f.seed = std::stoull(m.metadata.at("seed"));
+    if (m.metadata.count("lockstep")) lockstep = m.metadata.at("lockstep") == "true";
+    if (m.metadata.count("start_ns")) {
+      f.start = Time::FromNanoseconds(std::stoll(m.metadata.at("start_ns")));
+      f.has_start = true;
+    }
+  }
+  // Lockstep missions run on the datasets' fixed time origin.
+  if (!f.has_start && lockstep) {
+    f.start = sim::kDatasetStartTime;
+    f.has_start = true;
+  }
+  uint16_t state_channel = 0;
+  for (const auto& [id, channel] : reader.channels()) {
+    if (channel.topic == "/estimator/state") state_channel = id;
+  }
+  reader.ForEachMessage([&](const log::MessageView& m) {
+    if (m.channel_id != state_channel) return true;
+    log::rover_msgs::EstimatorState s;
+    if (!log::DeserializeMessage(m.data, &s)) return true;
+    f.last_stamp = Time::FromNanoseconds(s.stamp_ns);
+    if (f.initialised || (s.status & estimator::kStatusNotInitialised) != 0) return true;
+    f.initialised = true;
+    f.init_stamp = Time::FromNanoseconds(s.stamp_ns);
+    const auto& q = s.q_local_body_xyzw;
+    f.T_local0_body_init.linear() =
+        Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+    f.T_local0_body_init.translation() =
+        Eigen::Vector3d(s.p_local_body_m[0], s.p_local_body_m[1], s.p_local_body_m[2]);
+    return true;
+  });
+  if (!f.initialised) throw std::runtime_error(path + ": the filter never initialised");
+  return f;
+}
+
+// Position and yaw only: local frames are gravity-aligned.
+Eigen::Isometry3d FourDof(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Rz(YawOf(R));
+  T.translation() = p;
+  return T;
+}
+
+std::string Num(double v, int digits) {
+  if (!std::isfinite(v)) return "nan";
+  char text[48];
+  std::snprintf(text, sizeof(text), "%.*f", digits, v);
+  return text;
+}
+
+}  // namespace
+
+MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
+  const MissionFacts mission = ReadMission(o.mission_log);
+  const std::string scenario_name = o.scenario.empty() ? mission.scenario : o.scenario;
+  if (scenario_name.empty()) {
+    throw std::runtime_error(o.mission_log + ": no mission metadata; give --scenario and --seed");
+  }
+  if (!mission.has_start) {
+    throw std::runtime_error(o.mission_log +
+                             ": a real-time mission without its start time (start_ns)");
+  }
+  const uint64_t seed = o.seed >= 0 ? static_cast<uint64_t>(o.seed) : mission.seed;
+  const sim::Scenario scenario = sim::LoadScenario(
+      sim::FindScenario(sim::DefaultScenarioDir(), scenario_name), sim::DefaultSimConfigDir());
+  const sim::World world = sim::World::Generate(scenario.world, seed);
+  const sim::RoverTrajectory trajectory(scenario.route, world.terrain);
+
+  // Frame 0 in the world: the true body pose at initialisation against the
+  // filter's estimate then (x, y, z, yaw).
+  const sim::TrajectorySample truth =
+      trajectory.Evaluate((mission.init_stamp - mission.start).ToSeconds());
+  const Eigen::Isometry3d T_world_local0 =
+      FourDof(truth.p_world_body, truth.q_world_body.toRotationMatrix()) *
+      FourDof(mission.T_local0_body_init.translation(), mission.T_local0_body_init.linear())
+          .inverse();
+
+  std::map<uint32_t, Eigen::Isometry3d> origins = mapping::ReadFrameOrigins(o.mission_log);
+  for (auto& [frame, T] : origins) T = T_world_local0 * T;
+
+  MapResult r;
+  std::vector<mapping::SubmapLog> logs;
+  uint64_t submap_bytes = 0;
+  for (const std::string& path : o.mapd_logs) {
+    logs.push_back(mapping::ReadSubmapLog(path));
+    const mapping::SubmapLog& l = logs.back();
+    report << "  mapd log " << path << ": " << l.submaps.size() << " submaps\n";
+    for (const std::string& p : l.problems) report << "    problem: " << p << "\n";
+    for (const mapping::LoggedSubmap& s : l.submaps) {
+      submap_bytes += s.info.octree_bytes + s.info.cloud_bytes;
+    }
+    if (l.statistics.count("raw_stereo_bytes_per_s")) {
+      r.raw_stereo_bytes_per_s =
+          std::max(r.raw_stereo_bytes_per_s, std::stod(l.statistics.at("raw_stereo_bytes_per_s")));
+    }
+    r.submaps += l.submaps.size();
+  }
+  mapping::MapComposer composer;
+  const std::size_t unplaced = mapping::AddLoggedSubmaps(logs, origins, &composer);
+  if (unplaced > 0) report << "  " << unplaced << " submaps in frames the mission never had\n";
+  const auto start = std::chrono::steady_clock::now();
+  const octomap::OcTree& map = composer.Compose();
+  const mapping::PointCloud cloud = composer.ComposedCloud();
+  r.compose_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  r.map_memory_bytes = composer.Stats().octree_memory_bytes + composer.Stats().cloud_memory_bytes;
+  const double duration_s = (mission.last_stamp - mission.init_stamp).ToSeconds();
+  r.submap_bytes_per_s = duration_s > 0.0 ? static_cast<double>(submap_bytes) / duration_s : 0.0;
+
+  sim::ObstacleRuleOptions rule;
+  rule.rock_min_height_m = rule.step_height_m;  // rocks taller than a wheel climbs
+  const sim::ObstacleGrid obstacles = sim::ComputeObstacleCells(world, rule);
+  // The true camera along the mapped part of the mission, every 0.25 s.
+  std::vector<Eigen::Isometry3d> cameras;
+  const Eigen::Isometry3d T_body_cam0 = scenario.camera.T_body_cam0;
+  for (Time t = mission.init_stamp; t <= mission.last_stamp; t = t + Duration::FromSeconds(0.25)) {
+    const sim::TrajectorySample s = trajectory.Evaluate((t - mission.start).ToSeconds());
+    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    T_world_body.linear() = s.q_world_body.toRotationMatrix();
+    T_world_body.translation() = s.p_world_body;
+    cameras.push_back(T_world_body * T_body_cam0);
+  }
+  r.quality = EvaluateMap(world, obstacles, map, cloud, cameras, o.quality);
+  if (!o.export_stem.empty()) {
+    mapping::WriteOctreeBt(map, o.export_stem + ".bt");
+    mapping::WritePly(cloud, o.export_stem + ".ply");
+    report << "  world-frame map written to " << o.export_stem << ".bt and .ply\n";
+  }
+  const MapQuality& q = r.quality;
+  report << "  composed " << r.submaps << " submaps in " << Num(r.compose_ms, 1) << " ms, "
+         << Num(static_cast<double>(r.map_memory_bytes) / 1e6, 1) << " MB\n"
+         << "  occupancy  precision " << Num(q.map_precision, 3) << " (" << q.occupied_on_surface
+         << " of " << q.occupied_voxels << " occupied voxels on the true surface), recall "
+         << Num(q.map_recall, 3) << " (" << q.observed_columns_hit << " of " << q.observed_columns
+         << " observed columns)\n"
+         << "  obstacles  precision " << Num(q.obstacle_precision, 3) << " ("
+         << q.obstacle_points_true << " of " << q.obstacle_points << " flagged points), recall "
+         << Num(q.obstacle_recall, 3) << " (" << q.truth_obstacle_cells_found << " of "
+         << q.truth_obstacle_cells_observed << " observed obstacle cells)\n"
+         << "  bandwidth  " << Num(r.submap_bytes_per_s / 1e3, 1) << " KB/s as submaps, "
+         << Num(r.raw_stereo_bytes_per_s / 1e6, 2) << " MB/s raw stereo ("
+         << Num(r.raw_stereo_bytes_per_s > 0.0
+                    ? 100.0 * r.submap_bytes_per_s / r.raw_stereo_bytes_per_s
+                    : std::numeric_limits<double>::quiet_NaN(),
+                3)
+         << " %)\n";
+  return r;
+}
+
+std::string MapResultFields(const MapResult& r) {
+  const MapQuality& q = r.quality;
+  return "map_precision=" + Num(q.map_precision, 4) + " map_recall=" + Num(q.map_recall, 4) +
+         " obstacle_precision=" + Num(q.obstacle_precision, 4) +
+         " obstacle_recall=" + Num(q.obstacle_recall, 4) + " submaps=" + std::to_string(r.submaps) +
+         " submap_bytes_per_s=" + Num(r.submap_bytes_per_s, 0) +
+         " raw_stereo_bytes_per_s=" + Num(r.raw_stereo_bytes_per_s, 0);
+}
+
+int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err) {
+  try {
+    out << "rover-eval map: " << options.mission_log << "\n";
+    const MapResult r = EvaluateMission(options, out);
+    out << "RESULT " << MapResultFields(r) << "\n";
+    return kExitOk;
+  } catch (const std::exception& e) {
+    err << "rover-eval map: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+}
+
+Subcommand AddMapCommand(CLI::App& app) {
+  auto options = std::make_shared<MapCommandOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "map",
+      "quality of a simulated mission's map against the simulator's ground truth: occupied-voxel\n"
+      "precision and recall against the true terrain surface, obstacle precision and recall\n"
+      "against the true obstacle cells, and the submap bandwidth. Reads the mission log (frame\n"
+      "switches, estimates, scenario, seed) and mapd's log(s) (submaps).");
+  cmd->add_option("mission_log", options->mission_log, "the mission's flight log (roverd)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--mapd-log", options->mapd_logs, "mapd's log (repeat for a restarted mapd)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--scenario", options->scenario, "override the scenario recorded in the log");
+  cmd->add_option("--seed", options->seed, "override the seed recorded in the log");
+  cmd->add_option("--export", options->export_stem,
+                  "also write the world-frame map to STEM.bt (octovis) and STEM.ply");
+  cmd->add_option("--surface-tolerance-m", options->quality.surface_tolerance_m,
+                  "an occupied voxel within this of the true surface is correct")
+      ->capture_default_str();
+  cmd->add_option("--obstacle-radius-m", options->quality.obstacle_radius_m,
+                  "a flagged point within this of a true obstacle cell is correct")
+      ->capture_default_str();
+  cmd->add_option("--obstacle-view-range-m", options->quality.obstacle_view_range_m,
+                  "recall counts the true obstacles the camera saw from within this distance")
+      ->capture_default_str();
+  return {cmd, [options] { return RunMap(*options, std::cout, std::cerr); }};
+}
+
+}  // namespace rover::host::eval

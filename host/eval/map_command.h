@@ -1,0 +1,58 @@
+#ifndef ROVER_HOST_EVAL_MAP_COMMAND_H_
+#define ROVER_HOST_EVAL_MAP_COMMAND_H_
+
+// `rover-eval map`: the quality of the map of a simulated mission against the
+// simulator's ground truth (map_evaluation.h), and the submap bandwidth.
+// Reads the mission's flight log (roverd: frame switches, estimates, the
+// mission's scenario, seed and start time) and mapd's log(s) (submaps),
+// composes the global map in the world frame and scores it.
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "host/eval/map_evaluation.h"
+#include "host/eval/subcommand.h"
+
+namespace rover::host::eval {
+
+struct MapCommandOptions {
+  std::string mission_log;
+  std::vector<std::string> mapd_logs;
+  /// Override the scenario and seed recorded in the mission log.
+  std::string scenario;
+  int64_t seed = -1;
+  /// Also write the world-frame map to STEM.bt and STEM.ply.
+  std::string export_stem;
+  MapQualityOptions quality;
+};
+
+/// What RunMap measured (for rover-launch's RESULT line).
+struct MapResult {
+  MapQuality quality;
+  uint64_t submaps = 0;
+  double submap_bytes_per_s = 0.0;
+  double raw_stereo_bytes_per_s = 0.0;
+  double compose_ms = 0.0;
+  uint64_t map_memory_bytes = 0;
+};
+
+/// Evaluates; throws std::runtime_error naming the file or the problem.
+MapResult EvaluateMission(const MapCommandOptions& options, std::ostream& report);
+
+/// The RESULT fields of `r`: "map_precision=... map_recall=... ...".
+std::string MapResultFields(const MapResult& r);
+
+/// Runs the evaluation, prints the report and, as the last line,
+///   RESULT map_precision=... map_recall=... obstacle_precision=...
+///          obstacle_recall=... submaps=... submap_bytes_per_s=...
+///          raw_stereo_bytes_per_s=...
+/// Errors go to `err`; returns kExitBadInput for unusable input.
+int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err);
+
+/// Adds `rover-eval map` to `app` (see subcommand.h).
+Subcommand AddMapCommand(CLI::App& app);
+
+}  // namespace rover::host::eval
+
+#endif  // ROVER_HOST_EVAL_MAP_COMMAND_H_

@@ -1,0 +1,219 @@
+#include "host/eval/map_evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace rover::host::eval {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Packs signed 2D cell indices into one hash key.
+int64_t CellKey(int64_t ix, int64_t iy) { return (ix << 32) ^ (iy & 0xffffffff); }
+
+struct Disc {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double radius_m = 0.0;
+};
+
+// Horizontal discs around the static tag carriers: rendered objects that
+// the heightfield (the surface ground truth) does not contain.
+std::vector<Disc> CarrierDiscs(const sim::World& world, double margin_m) {
+  std::vector<Disc> discs;
+  for (const sim::TagCarrier& c : world.carriers) {
+    if (!c.is_static) continue;
+    double r = 0.0;
+    for (const sim::Box& b : c.boxes) {
+      r = std::max(r, b.center_carrier.head<2>().norm() + 0.5 * b.size_m.head<2>().norm());
+    }
+    discs.push_back({c.T_world_carrier.translation().head<2>(), r + margin_m});
+  }
+  return discs;
+}
+
+bool NearCarrier(const std::vector<Disc>& discs, const Eigen::Vector2d& xy) {
+  return std::any_of(discs.begin(), discs.end(),
+                     [&xy](const Disc& d) { return (xy - d.centre).norm() <= d.radius_m; });
+}
+
+// Lowest and highest terrain over the square cell of side `size_m` at xy.
+std::pair<double, double> HeightRange(const sim::Heightfield& terrain, const Eigen::Vector2d& xy,
+                                      double size_m) {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -lo;
+  for (int j = 0; j < 5; ++j) {
+    for (int i = 0; i < 5; ++i) {
+      const double x = xy.x() + size_m * (i / 4.0 - 0.5);
+      const double y = xy.y() + size_m * (j / 4.0 - 0.5);
+      const double h = terrain.HeightAt(x, y);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+    }
+  }
+  return {lo, hi};
+}
+
+// Calls fn(centre, occupied) for every finest-resolution voxel the tree
+// knows (pruned leaves expanded).
+template <typename Fn>
+void ForEachVoxel(const octomap::OcTree& tree, Fn&& fn) {
+  const double res = tree.getResolution();
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    const bool occupied = tree.isNodeOccupied(*it);
+    const double size = it.getSize();
+    const int n = std::max(1, static_cast<int>(std::lround(size / res)));
+    const octomap::point3d c = it.getCoordinate();
+    for (int k = 0; k < n; ++k) {
+      for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+          const Eigen::Vector3d p(static_cast<double>(c.x()) - 0.5 * size + res * (i + 0.5),
+                                  static_cast<double>(c.y()) - 0.5 * size + res * (j + 0.5),
+                                  static_cast<double>(c.z()) - 0.5 * size + res * (k + 0.5));
+          fn(p, occupied);
+        }
+      }
+    }
+  }
+}
+
+void ScoreOccupancy(const sim::World& world, const octomap::OcTree& map, const MapQualityOptions& o,
+                    MapQuality* q) {
+  const std::vector<Disc> carriers = CarrierDiscs(world, o.carrier_margin_m);
+  const double res = map.getResolution();
+  // Per column: bit 0 observed, bit 1 hit.
+  std::unordered_map<int64_t, uint8_t> columns;
+  ForEachVoxel(map, [&](const Eigen::Vector3d& p, bool occupied) {
+    const Eigen::Vector2d xy = p.head<2>();
+    if (!world.terrain.Contains(xy.x(), xy.y()) || NearCarrier(carriers, xy)) return;
+    const auto [lo, hi] = HeightRange(world.terrain, xy, res);
+    const bool on_surface = hi >= p.z() - 0.5 * res - o.surface_tolerance_m &&
+                            lo <= p.z() + 0.5 * res + o.surface_tolerance_m;
+    if (occupied) {
+      ++q->occupied_voxels;
+      if (on_surface) ++q->occupied_on_surface;
+    }
+    const int64_t key = CellKey(static_cast<int64_t>(std::floor(xy.x() / res)),
+                                static_cast<int64_t>(std::floor(xy.y() / res)));
+    const double h = world.terrain.HeightAt(xy.x(), xy.y());
+    uint8_t& flags = columns[key];
+    if (std::abs(p.z() - h) <= o.observed_band_m) flags |= 1;
+    if (occupied && on_surface) flags |= 2;
+  });
+  for (const auto& [key, flags] : columns) {
+    if ((flags & 1) == 0) continue;
+    ++q->observed_columns;
+    if ((flags & 2) != 0) ++q->observed_columns_hit;
+  }
+  q->map_precision = q->occupied_voxels > 0 ? static_cast<double>(q->occupied_on_surface) /
+                                                  static_cast<double>(q->occupied_voxels)
+                                            : kNaN;
+  q->map_recall = q->observed_columns > 0 ? static_cast<double>(q->observed_columns_hit) /
+                                                static_cast<double>(q->observed_columns)
+                                          : kNaN;
+}
+
+// Whether some camera saw the horizontal point xy within range and field
+// of view.
+bool SeenClose(const std::vector<Eigen::Isometry3d>& cameras, const Eigen::Vector2d& xy,
+               const MapQualityOptions& o) {
+  for (const Eigen::Isometry3d& T : cameras) {
+    const Eigen::Vector2d to = xy - T.translation().head<2>();
+    const double range = to.norm();
+    if (range > o.obstacle_view_range_m || range < 1e-6) continue;
+    const Eigen::Vector2d forward = (T.linear() * Eigen::Vector3d::UnitZ()).head<2>();
+    if (forward.norm() < 1e-6) continue;
+    const double cos_angle = forward.normalized().dot(to / range);
+    if (cos_angle >= std::cos(o.camera_half_fov_rad)) return true;
+  }
+  return false;
+}
+
+void ScoreObstacles(const sim::ObstacleGrid& truth, const mapping::PointCloud& cloud,
+                    const std::vector<Eigen::Isometry3d>& cameras, const MapQualityOptions& o,
+                    MapQuality* q) {
+  const double res = truth.resolution_m;
+  const auto cell_of = [&](const Eigen::Vector3f& p, int64_t* ix, int64_t* iy) {
+    *ix =
+        static_cast<int64_t>(std::floor((static_cast<double>(p.x()) - truth.origin_xy.x()) / res));
+    *iy =
+        static_cast<int64_t>(std::floor((static_cast<double>(p.y()) - truth.origin_xy.y()) / res));
+    return *ix >= 0 && *iy >= 0 && *ix < truth.cols && *iy < truth.rows;
+  };
+  const auto is_obstacle = [&](int64_t ix, int64_t iy) {
+    if (ix < 0 || iy < 0 || ix >= truth.cols || iy >= truth.rows) return false;
+    const sim::ObstacleCode c = truth.CodeAt(static_cast<int>(ix), static_cast<int>(iy));
+    return c == sim::ObstacleCode::kPositive || c == sim::ObstacleCode::kNegative;
+  };
+  const int reach = static_cast<int>(std::ceil(o.obstacle_radius_m / res));
+  const double reach2 = (o.obstacle_radius_m / res) * (o.obstacle_radius_m / res);
+  std::unordered_set<int64_t> seen;
+  std::unordered_set<int64_t> flagged;
+  int64_t min_x = truth.cols, min_y = truth.rows, max_x = -1, max_y = -1;
+  for (const mapping::CloudPoint& p : cloud) {
+    int64_t ix = 0;
+    int64_t iy = 0;
+    if (!cell_of(p.p_submap_m, &ix, &iy)) continue;
+    seen.insert(CellKey(ix, iy));
+    min_x = std::min(min_x, ix);
+    min_y = std::min(min_y, iy);
+    max_x = std::max(max_x, ix);
+    max_y = std::max(max_y, iy);
+    if (!p.obstacle) continue;
+    ++q->obstacle_points;
+    flagged.insert(CellKey(ix, iy));
+    bool near = false;
+    for (int dy = -reach; dy <= reach && !near; ++dy) {
+      for (int dx = -reach; dx <= reach && !near; ++dx) {
+        near = dx * dx + dy * dy <= reach2 && is_obstacle(ix + dx, iy + dy);
+      }
+    }
+    if (near) ++q->obstacle_points_true;
+  }
+  for (int64_t iy = min_y; iy <= max_y; ++iy) {
+    for (int64_t ix = min_x; ix <= max_x; ++ix) {
+      if (!is_obstacle(ix, iy)) continue;
+      bool observed = false;
+      for (int dy = -1; dy <= 1 && !observed; ++dy) {
+        for (int dx = -1; dx <= 1 && !observed; ++dx)
+          observed = seen.count(CellKey(ix + dx, iy + dy)) > 0;
+      }
+      if (!observed) continue;
+      const Eigen::Vector2d cell(truth.origin_xy.x() + (static_cast<double>(ix) + 0.5) * res,
+                                 truth.origin_xy.y() + (static_cast<double>(iy) + 0.5) * res);
+      if (!SeenClose(cameras, cell, o)) continue;
+      ++q->truth_obstacle_cells_observed;
+      bool found = false;
+      for (int dy = -reach; dy <= reach && !found; ++dy) {
+        for (int dx = -reach; dx <= reach && !found; ++dx) {
+          found = dx * dx + dy * dy <= reach2 && flagged.count(CellKey(ix + dx, iy + dy)) > 0;
+        }
+      }
+      if (found) ++q->truth_obstacle_cells_found;
+    }
+  }
+  q->obstacle_precision = q->obstacle_points > 0 ? static_cast<double>(q->obstacle_points_true) /
+                                                       static_cast<double>(q->obstacle_points)
+                                                 : kNaN;
+  q->obstacle_recall = q->truth_obstacle_cells_observed > 0
+                           ? static_cast<double>(q->truth_obstacle_cells_found) /
+                                 static_cast<double>(q->truth_obstacle_cells_observed)
+                           : kNaN;
+}
+
+}  // namespace
+
+MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
+                       const octomap::OcTree& map_world, const mapping::PointCloud& cloud_world,
+                       const std::vector<Eigen::Isometry3d>& T_world_cameras,
+                       const MapQualityOptions& options) {
+  MapQuality q;
+  ScoreOccupancy(world, map_world, options, &q);
+  ScoreObstacles(truth, cloud_world, T_world_cameras, options, &q);
+  return q;
+}
+
+}  // namespace rover::host::eval

@@ -1,0 +1,81 @@
+#ifndef ROVER_HOST_EVAL_MAP_EVALUATION_H_
+#define ROVER_HOST_EVAL_MAP_EVALUATION_H_
+
+// Quality of a composed map against the simulator's ground truth.
+//
+// Occupancy (10 cm voxels of the composed OctoMap, world frame):
+//  * a voxel is on the surface if the ground-truth terrain passes within
+//    `surface_tolerance_m` of the voxel's vertical extent somewhere in its
+//    footprint (heights sampled on a 5x5 grid over the cell);
+//  * precision = occupied voxels on the surface / occupied voxels;
+//  * recall = observed surface columns with an occupied surface voxel /
+//    observed surface columns, where a 10 cm column is observed if the map
+//    knows (free or occupied) any voxel within `observed_band_m` of the
+//    surface there: the camera saw that spot, so the surface should be in
+//    the map.
+// Voxels near the simulator's tag carriers (posts, other rovers: rendered,
+// but not part of the heightfield) are left out of both.
+//
+// Obstacles (5 cm cells of the simulator's obstacle grid, computed with
+// rock_min_height_m = h_max so that only rocks taller than a wheel can
+// climb count, plus steps and the top edges of drops):
+//  * precision = obstacle-flagged cloud points within `obstacle_radius_m`
+//    of a ground-truth obstacle cell / flagged points;
+//  * recall = ground-truth obstacle cells with a flagged point within
+//    `obstacle_radius_m` / ground-truth obstacle cells that were observed:
+//    the map has a point within one cell of it, and the camera saw it from
+//    within `obstacle_view_range_m` (horizontal distance, inside the
+//    camera's horizontal field of view) at one of the given camera poses.
+//    Stereo error grows with the square of the distance, so obstacles only
+//    ever glimpsed at the far end of stereo range are not counted against
+//    the classifier; the rover has to find those it comes close to.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include <octomap/OcTree.h>
+
+#include "hil/sim/world/world.h"
+#include "mapping/submap/cloud_point.h"
+
+namespace rover::host::eval {
+
+struct MapQualityOptions {
+  double surface_tolerance_m = 0.1;
+  double observed_band_m = 0.3;
+  double obstacle_radius_m = 0.15;
+  /// Half-width of the area left out around each tag carrier.
+  double carrier_margin_m = 0.3;
+  double obstacle_view_range_m = 4.0;
+  double camera_half_fov_rad = 0.6;
+};
+
+struct MapQuality {
+  uint64_t occupied_voxels = 0;
+  uint64_t occupied_on_surface = 0;
+  uint64_t observed_columns = 0;
+  uint64_t observed_columns_hit = 0;
+  double map_precision = 0.0;
+  double map_recall = 0.0;
+  uint64_t obstacle_points = 0;
+  uint64_t obstacle_points_true = 0;
+  uint64_t truth_obstacle_cells_observed = 0;
+  uint64_t truth_obstacle_cells_found = 0;
+  double obstacle_precision = 0.0;
+  double obstacle_recall = 0.0;
+};
+
+/// Scores `map_world` and `cloud_world` (CloudPoint::p_submap_m in world
+/// coordinates) against `world` and its obstacle grid `truth`.
+/// `T_world_cameras` are the left camera's true poses along the mission
+/// (for the obstacles' view range; OpenCV axes, z forward).
+MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
+                       const octomap::OcTree& map_world, const mapping::PointCloud& cloud_world,
+                       const std::vector<Eigen::Isometry3d>& T_world_cameras,
+                       const MapQualityOptions& options = {});
+
+}  // namespace rover::host::eval
+
+#endif  // ROVER_HOST_EVAL_MAP_EVALUATION_H_
