@@ -6,9 +6,11 @@
 //   0 success, 1 the file is damaged (verify) or partly unreadable,
 //   2 bad usage or unreadable input.
 
+#include <cstddef>
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "core/log/mcap/mcap_writer.h"
 
@@ -38,6 +40,35 @@ int RunVerify(const std::string& path, std::ostream& out, std::ostream& err);
 /// file OUT and reports what could not be saved.
 int RunRecover(const std::string& in, const std::string& out_path,
                const log::McapWriterOptions& options, std::ostream& out, std::ostream& err);
+
+struct MapOptions {
+  /// mapd's logs (mapd-<time>-<pid>.mcap), in the order mapd wrote them;
+  /// a restarted mapd leaves several.
+  std::vector<std::string> mapd_logs;
+  /// roverd's flight log, whose frame switches place every submap in the
+  /// mission's frame 0. Empty: one mapd log only, its submaps chained by
+  /// their SubmapInfo origins from the first submap's frame.
+  std::string roverd_log;
+  /// Output path without extension: STEM.bt, STEM.ot, STEM.ply.
+  std::string out_stem;
+  bool write_bt = true;
+  bool write_ot = true;
+  bool write_ply = true;
+  /// Compose the point cloud (needed for the .ply); --no-cloud clears it.
+  bool compose_cloud = true;
+  /// Progress lines on `err` once at least this many submaps are composed.
+  std::size_t progress_min_submaps = 20;
+};
+
+/// `rover-log map MAPD_LOG... [--roverd-log ROVERD] --out STEM`: the global
+/// map of a mission from the submaps mapd logged, each placed at its frame's
+/// origin and merged (octree and point cloud), written as STEM.bt / .ot /
+/// .ply. Prints per log its submaps and the problems found (reading goes on
+/// past damage), the submaps that could not be placed, and the composed
+/// map's size, memory and compose time. Exit 0 ok, 1 the map was written but
+/// input was damaged or submaps were left out, 2 bad usage, an unreadable
+/// or non-MCAP file, no submaps at all, or an output that cannot be written.
+int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err);
 
 /// How `list` and `download` reach the board's log service.
 struct LogServiceAccess {

@@ -1,10 +1,11 @@
 // rover-log: list and download logs from the board, inspect, export, verify and repair rover
-// flight logs (MCAP).
+// flight logs (MCAP), extract the global map from mapd's logs.
 
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <iostream>
 #include <map>
 
@@ -12,7 +13,8 @@
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "rover-log: list and download, inspect, export, verify and repair rover flight logs.\n"
+      "rover-log: list and download, inspect, export, verify and repair rover flight logs,\n"
+      "and extract the global map from mapd's logs.\n"
       "Flight logs are MCAP files with ROS 2 CDR messages (they open in Foxglove Studio and play\n"
       "with `ros2 bag`). A log cut short by power loss stays readable up to its last complete\n"
       "chunk; `verify` says what is damaged and where, `recover` saves the rest."};
@@ -117,6 +119,47 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
 
+  rover::host::MapOptions map_options;
+  std::vector<std::string> map_formats;
+  bool map_no_cloud = false;
+  auto* map_command = app.add_subcommand(
+      "map",
+      "Extract the global map from mapd's logs into STEM.bt, STEM.ot, STEM.ply (view with\n"
+      "`octovis STEM.bt` and any PLY viewer)");
+  map_command->footer(
+      "Reads every submap mapd logged (/mapd/submap/info, /mapd/submap/octomap and\n"
+      "/mapd/submap/cloud in mapd-<time>-<pid>.mcap; give all logs of a restarted mapd, in\n"
+      "order) and places each at its frame's origin: with --roverd-log, chained from the\n"
+      "frame switches (/estimator/frame_switch_record) in roverd's flight log, frame 0 of\n"
+      "the mission being the map frame; without it (one mapd log only), chained by the\n"
+      "origins the submaps record, the first submap's frame being the map frame. Submaps\n"
+      "are merged into one octree (log-odds summed, clamped) and one point cloud.\n"
+      "Writes STEM.bt (occupied/free octree), STEM.ot (octree with probabilities) and\n"
+      "STEM.ply (point cloud, obstacles red); view them with `octovis STEM.bt` (or .ot)\n"
+      "and any PLY viewer (MeshLab, CloudCompare, Open3D). Prints each log's submaps,\n"
+      "damage found (reading goes on past it), submaps that could not be placed and the\n"
+      "composed map's size, memory and compose time.\n"
+      "Exit 0 ok, 1 map written but input damaged or submaps left out, 2 bad usage, an\n"
+      "unreadable or non-MCAP file, no submaps at all, or an output that cannot be written.");
+  map_command->add_option("MAPD_LOG", map_options.mapd_logs, "mapd log(s) (mapd-<time>-<pid>.mcap)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  map_command
+      ->add_option("--roverd-log", map_options.roverd_log,
+                   "roverd's flight log of the same mission, for the frame switches (required "
+                   "with several mapd logs)")
+      ->check(CLI::ExistingFile);
+  map_command
+      ->add_option("--out", map_options.out_stem,
+                   "output path without extension: writes STEM.bt, STEM.ot, STEM.ply")
+      ->required();
+  map_command->add_flag("--no-cloud", map_no_cloud,
+                        "do not compose the point cloud (faster, less memory; no .ply)");
+  map_command
+      ->add_option("--format", map_formats, "files to write, comma-separated (default: bt,ot,ply)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"bt", "ot", "ply"}));
+
   // Usage errors exit with 2, as the subcommands do for bad input.
   try {
     app.parse(argc, argv);
@@ -129,6 +172,20 @@ int main(int argc, char** argv) {
   if (*exp) return rover::host::RunExport(export_options, std::cout, std::cerr);
   if (*verify) return rover::host::RunVerify(path, std::cout, std::cerr);
   if (*list) return rover::host::RunList(list_options, std::cout, std::cerr);
+  if (*map_command) {
+    map_options.compose_cloud = !map_no_cloud;
+    if (!map_formats.empty()) {
+      const auto has = [&](const char* f) {
+        return std::find(map_formats.begin(), map_formats.end(), f) != map_formats.end();
+      };
+      map_options.write_bt = has("bt");
+      map_options.write_ot = has("ot");
+      map_options.write_ply = has("ply");
+    } else if (map_no_cloud) {
+      map_options.write_ply = false;
+    }
+    return rover::host::RunMap(map_options, std::cout, std::cerr);
+  }
   if (*download) {
     download_options.progress_tty = ::isatty(STDERR_FILENO) == 1;
     return rover::host::RunDownload(download_options, std::cout, std::cerr);

@@ -1,0 +1,297 @@
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include "host/log/commands.h"
+#include "host/log/format.h"
+#include "host/log/submap_chain.h"
+#include "mapping/compose/map_composer.h"
+#include "mapping/compose/map_export.h"
+#include "mapping/compose/submap_log.h"
+
+namespace rover::host {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MillisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A submap that goes into the map, and where.
+struct Placement {
+  std::size_t log = 0;
+  std::size_t submap = 0;
+  Eigen::Isometry3d T_map_submap = Eigen::Isometry3d::Identity();
+};
+
+// Occupied finest voxels: a pruned occupied leaf counts for every voxel it
+// covers.
+uint64_t OccupiedVoxels(const octomap::OcTree& tree) {
+  const unsigned max_depth = tree.getTreeDepth();
+  uint64_t voxels = 0;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (tree.isNodeOccupied(*it)) voxels += uint64_t{1} << (3 * (max_depth - it.getDepth()));
+  }
+  return voxels;
+}
+
+void PrintSubmapTable(const mapping::SubmapLog& log, const std::vector<bool>& placed,
+                      std::ostream& out) {
+  char line[256];
+  std::snprintf(line, sizeof line, "    %6s %6s %7s %11s %12s %12s  %s\n", "index", "frame",
+                "images", "distance_m", "octree", "cloud", "placed");
+  out << line;
+  for (std::size_t i = 0; i < log.submaps.size(); ++i) {
+    const log::rover_msgs::SubmapInfo& info = log.submaps[i].info;
+    std::snprintf(line, sizeof line, "    %6u %6u %7u %11.2f %12s %12s  %s\n", info.index,
+                  info.frame_id, info.images, info.distance_m,
+                  FormatBytes(info.octree_bytes).c_str(), FormatBytes(info.cloud_bytes).c_str(),
+                  placed[i] ? "yes" : "no");
+    out << line;
+  }
+}
+
+}  // namespace
+
+int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
+  const char* const kTool = "rover-log map: ";
+  // Usage.
+  if (options.mapd_logs.empty()) {
+    err << kTool << "no mapd log given\n";
+    return 2;
+  }
+  if (options.roverd_log.empty() && options.mapd_logs.size() > 1) {
+    err << kTool << options.mapd_logs.size()
+        << " mapd logs need --roverd-log ROVERD.mcap: only roverd's frame switches place the "
+           "submaps of a restarted mapd in one frame\n";
+    return 2;
+  }
+  if (options.out_stem.empty()) {
+    err << kTool << "no output given (--out STEM)\n";
+    return 2;
+  }
+  if (!options.write_bt && !options.write_ot && !options.write_ply) {
+    err << kTool << "no output format selected (--format bt,ot,ply)\n";
+    return 2;
+  }
+  if (options.write_ply && !options.compose_cloud) {
+    err << kTool << "--no-cloud leaves nothing for the .ply; select --format bt,ot\n";
+    return 2;
+  }
+
+  // Read every mapd log; damage inside one is a problem, not an error.
+  std::vector<mapping::SubmapLog> logs;
+  std::size_t total_submaps = 0;
+  for (std::size_t i = 0; i < options.mapd_logs.size(); ++i) {
+    const std::string& path = options.mapd_logs[i];
+    if (options.mapd_logs.size() > 1) {
+      err << kTool << "reading " << path << " (" << i + 1 << "/" << options.mapd_logs.size()
+          << ")\n";
+    }
+    try {
+      logs.push_back(mapping::ReadSubmapLog(path));
+    } catch (const std::exception& e) {
+      err << kTool << e.what() << "\n";
+      return 2;
+    }
+    total_submaps += logs.back().submaps.size();
+  }
+  if (total_submaps == 0) {
+    err << kTool << "no submaps in";
+    for (const std::string& path : options.mapd_logs) err << " " << path;
+    err << " (no complete " << mapping::kSubmapInfoTopic << " + " << mapping::kSubmapOctomapTopic
+        << " + " << mapping::kSubmapCloudTopic << " message triple; is this a mapd log?)\n";
+    for (const mapping::SubmapLog& l : logs) {
+      for (const std::string& p : l.problems) err << "  " << p << "\n";
+    }
+    return 2;
+  }
+
+  // Where each frame lies in the map frame.
+  std::map<uint32_t, Eigen::Isometry3d> origins;
+  if (!options.roverd_log.empty()) {
+    try {
+      origins = mapping::ReadFrameOrigins(options.roverd_log);
+    } catch (const std::exception& e) {
+      err << kTool << e.what() << "\n";
+      return 2;
+    }
+  } else {
+    origins = ChainSubmapOrigins(logs.front().submaps);
+  }
+
+  // The submaps that can be placed; the map's resolution is the first
+  // submap's (mapd uses one for all).
+  double resolution_m = 0.0;
+  for (const mapping::SubmapLog& l : logs) {
+    if (!l.submaps.empty()) {
+      resolution_m = l.submaps.front().octree->getResolution();
+      break;
+    }
+  }
+  std::vector<Placement> placements;
+  std::vector<std::vector<bool>> placed(logs.size());
+  std::vector<std::string> unplaced;
+  for (std::size_t l = 0; l < logs.size(); ++l) {
+    placed[l].assign(logs[l].submaps.size(), false);
+    for (std::size_t s = 0; s < logs[l].submaps.size(); ++s) {
+      const mapping::LoggedSubmap& submap = logs[l].submaps[s];
+      const std::string name = "log " + std::to_string(l + 1) + " submap " +
+                               std::to_string(submap.info.index) + " (frame " +
+                               std::to_string(submap.info.frame_id) + ")";
+      const auto origin = origins.find(submap.info.frame_id);
+      if (origin == origins.end()) {
+        unplaced.push_back(name + ": " +
+                           (options.roverd_log.empty()
+                                ? WhyUnplaced(submap.info, origins)
+                                : "no frame switch of " + options.roverd_log + " reaches frame " +
+                                      std::to_string(submap.info.frame_id)));
+        continue;
+      }
+      if (submap.octree->getResolution() != resolution_m) {
+        char why[128];
+        std::snprintf(why, sizeof why, ": octree resolution %.3f m, the map's is %.3f m",
+                      submap.octree->getResolution(), resolution_m);
+        unplaced.push_back(name + why);
+        continue;
+      }
+      placements.push_back({l, s, origin->second});
+      placed[l][s] = true;
+    }
+  }
+
+  // Per log: its submaps and problems.
+  std::size_t problem_count = 0;
+  out << "rover-log map: " << logs.size() << " mapd log(s), " << total_submaps
+      << " submap(s); map frame: "
+      << (options.roverd_log.empty() ? "the first submap's frame (chained by SubmapInfo origins)"
+                                     : "frame 0 of " + options.roverd_log + " (" +
+                                           std::to_string(origins.size()) + " frame(s) placed)")
+      << "\n";
+  for (std::size_t l = 0; l < logs.size(); ++l) {
+    const mapping::SubmapLog& log = logs[l];
+    out << "log " << l + 1 << ": " << options.mapd_logs[l] << "\n";
+    out << "  submaps: " << log.submaps.size()
+        << ", traversability grids: " << log.traversability_grids << ", mapd statistics: "
+        << (log.statistics.empty() ? "absent (mapd did not stop cleanly)" : "present") << "\n";
+    if (!log.submaps.empty()) PrintSubmapTable(log, placed[l], out);
+    if (!log.problems.empty()) {
+      out << "  problems: " << log.problems.size() << "\n";
+      for (const std::string& p : log.problems) out << "    " << p << "\n";
+    }
+    problem_count += log.problems.size();
+  }
+  out << "unplaced submaps: " << unplaced.size() << "\n";
+  for (const std::string& u : unplaced) out << "  " << u << "\n";
+  if (placements.empty()) {
+    err << kTool << "none of the " << total_submaps << " submap(s) could be placed\n";
+    return 2;
+  }
+
+  // Compose, in log then submap order (the order mapd built them).
+  mapping::MapComposerOptions composer_options;
+  composer_options.resolution_m = resolution_m;
+  std::optional<mapping::MapComposer> composer;
+  const octomap::OcTree* tree = nullptr;
+  const bool show_progress = placements.size() >= options.progress_min_submaps;
+  const std::size_t progress_step = std::max<std::size_t>(1, placements.size() / 10);
+  const Clock::time_point compose_start = Clock::now();
+  try {
+    composer.emplace(composer_options);
+    for (std::size_t i = 0; i < placements.size(); ++i) {
+      const Placement& p = placements[i];
+      const mapping::LoggedSubmap& s = logs[p.log].submaps[p.submap];
+      composer->SetSubmap(static_cast<uint32_t>(i), s.octree, s.cloud, p.T_map_submap);
+      if (show_progress && ((i + 1) % progress_step == 0 || i + 1 == placements.size())) {
+        // Merging now costs no more than merging all at the end: each call
+        // appends only the new submaps to the cached composition.
+        composer->Compose();
+        err << kTool << "composing: " << i + 1 << "/" << placements.size() << " submaps\n";
+      }
+    }
+    tree = &composer->Compose();
+  } catch (const std::exception& e) {
+    err << kTool << "composing the map failed: " << e.what() << "\n";
+    return 2;
+  }
+  const double octree_ms = MillisecondsSince(compose_start);
+  mapping::PointCloud cloud;
+  double cloud_ms = 0.0;
+  if (options.compose_cloud) {
+    const Clock::time_point cloud_start = Clock::now();
+    cloud = composer->ComposedCloud();
+    cloud_ms = MillisecondsSince(cloud_start);
+  }
+  const mapping::MapComposerStats stats = composer->Stats();
+  std::size_t obstacles = 0;
+  for (const mapping::CloudPoint& p : cloud) obstacles += p.obstacle ? 1 : 0;
+
+  char line[256];
+  out << "composed map:\n";
+  out << "  submaps placed:   " << placements.size() << " of " << total_submaps << "\n";
+  std::snprintf(line, sizeof line, "  octree leaves:    %zu (resolution %.3f m)\n",
+                stats.composed_leaves, resolution_m);
+  out << line;
+  out << "  occupied voxels:  " << OccupiedVoxels(*tree) << "\n";
+  if (options.compose_cloud) {
+    out << "  cloud points:     " << cloud.size() << "\n";
+    out << "  obstacle points:  " << obstacles << "\n";
+  } else {
+    out << "  cloud points:     not composed (--no-cloud)\n";
+  }
+  out << "  memory:           octree " << FormatBytes(stats.octree_memory_bytes) << ", cloud "
+      << FormatBytes(stats.cloud_memory_bytes) << "\n";
+  std::snprintf(line, sizeof line, "  compose time:     octree %.1f ms, cloud %.1f ms\n", octree_ms,
+                cloud_ms);
+  out << line;
+
+  // Write.
+  std::vector<std::string> written;
+  try {
+    const std::filesystem::path parent = std::filesystem::path(options.out_stem).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    if (options.write_bt) {
+      written.push_back(options.out_stem + ".bt");
+      mapping::WriteOctreeBt(*tree, written.back());
+    }
+    if (options.write_ot) {
+      written.push_back(options.out_stem + ".ot");
+      mapping::WriteOctreeOt(*tree, written.back());
+    }
+    if (options.write_ply) {
+      written.push_back(options.out_stem + ".ply");
+      mapping::WritePly(cloud, written.back());
+    }
+  } catch (const std::exception& e) {
+    err << kTool << "cannot write " << (written.empty() ? options.out_stem : written.back()) << ": "
+        << e.what() << "\n";
+    return 2;
+  }
+  out << "wrote:\n";
+  for (const std::string& path : written) out << "  " << path << "\n";
+  out << "view with: ";
+  if (options.write_bt || options.write_ot) {
+    out << "octovis " << (options.write_bt ? written.front() : options.out_stem + ".ot");
+  }
+  if (options.write_ply) {
+    out << ((options.write_bt || options.write_ot) ? "; " : "") << written.back()
+        << " in any PLY viewer (MeshLab, CloudCompare)";
+  }
+  out << "\n";
+
+  if (problem_count > 0 || !unplaced.empty()) {
+    err << kTool << "the map is incomplete: " << problem_count << " problem(s) in the input, "
+        << unplaced.size() << " submap(s) left out\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace rover::host
