@@ -1,12 +1,16 @@
 // rover-launch: the launcher of the simulated mission. Starts RouDi (unless
 // one already runs), mapd and roverd-sim, restarts mapd whenever it dies
 // (as systemd does on a board: Restart=always), and when roverd-sim is done
-// stops mapd and the RouDi it started. Exits with roverd-sim's status.
+// stops mapd and the RouDi it started. With --evaluate-map it then scores
+// the mission's map against the simulator's ground truth (rover-eval map)
+// and ends with roverd-sim's RESULT line extended by the map's fields.
+// Exits with roverd-sim's status.
 
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -17,9 +21,12 @@
 #include <thread>
 #include <vector>
 
+#include <iostream>
+
 #include "core/ipc/iceoryx_transport.h"
 #include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/process/child_process.h"
+#include "host/eval/map_command.h"
 
 namespace {
 
@@ -32,6 +39,47 @@ volatile std::sig_atomic_t g_stop = 0;
 void OnSignal(int) { g_stop = 1; }
 
 void Say(const std::string& text) { std::fprintf(stderr, "rover-launch: %s\n", text.c_str()); }
+
+// The value of `key=` in a RESULT line ("" if absent).
+std::string ResultField(const std::string& line, const std::string& key) {
+  const std::size_t at = line.find(" " + key + "=");
+  if (at == std::string::npos) return "";
+  const std::size_t begin = at + key.size() + 2;
+  return line.substr(begin, line.find_first_of(" \n", begin) - begin);
+}
+
+// Scores the mission's map and prints the extended RESULT line. mapd's logs
+// are those its processes (`mapd_pids`) wrote into `map_dir`.
+void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
+                 const std::vector<int>& mapd_pids) {
+  std::string line = roverd_result.substr(0, roverd_result.find('\n'));
+  rover::host::eval::MapCommandOptions options;
+  options.mission_log = ResultField(line, "log");
+  for (const auto& entry : fs::directory_iterator(map_dir)) {
+    const std::string name = entry.path().filename().string();
+    for (const int pid : mapd_pids) {
+      const std::string suffix = "-" + std::to_string(pid) + ".mcap";
+      if (name.rfind("mapd-", 0) == 0 && name.size() > suffix.size() &&
+          name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        options.mapd_logs.push_back(entry.path().string());
+      }
+    }
+  }
+  std::sort(options.mapd_logs.begin(), options.mapd_logs.end());
+  try {
+    if (options.mission_log.empty()) throw std::runtime_error("roverd-sim gave no log= field");
+    if (options.mapd_logs.empty())
+      throw std::runtime_error("mapd wrote no log in " + map_dir.string());
+    std::cout << "map (rover-eval map " << options.mission_log << "):\n";
+    const rover::host::eval::MapResult r = rover::host::eval::EvaluateMission(options, std::cout);
+    std::cout << line << " " << rover::host::eval::MapResultFields(r) << "\n";
+  } catch (const std::exception& e) {
+    Say("map evaluation: " + std::string(e.what()));
+    std::cout << line
+              << " map_precision=nan map_recall=nan obstacle_precision=nan obstacle_recall=nan "
+                 "submaps=0 submap_bytes_per_s=nan raw_stereo_bytes_per_s=nan\n";
+  }
+}
 
 std::optional<ChildProcess> StartRouDi(const std::string& config, const fs::path& run_dir) {
   if (rover::ipc::IceoryxTransport::IsRouDiRunning()) {
@@ -93,6 +141,12 @@ int main(int argc, char** argv) {
   std::string config;
   app.add_option("--config", config,
                  "board profile for mapd and roverd-sim (and mapd's restart back-off)");
+  std::string evaluate_map;
+  app.add_option("--evaluate-map", evaluate_map,
+                 "mapd writes its logs and map into this folder, and after the mission the map "
+                 "is scored against the simulator's ground truth: the RESULT line gains "
+                 "map_precision, map_recall, obstacle_precision, obstacle_recall, submaps, "
+                 "submap_bytes_per_s and raw_stereo_bytes_per_s");
   app.add_option("roverd_args", roverd_args, "arguments for roverd-sim (after --)");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGTERM, OnSignal);
@@ -107,12 +161,21 @@ int main(int argc, char** argv) {
       roverd_args.insert(roverd_args.begin(), {"--config", config});
     }
     fs::create_directories(run_dir);
+    const fs::path result_file = fs::path(run_dir) / "roverd_result.txt";
+    if (!evaluate_map.empty()) {
+      fs::create_directories(evaluate_map);
+      fs::remove(result_file);
+      mapd_args.insert(mapd_args.end(), {"--out", evaluate_map});
+      roverd_args.insert(roverd_args.end(), {"--result-file", result_file.string()});
+    }
+    std::vector<int> mapd_pids;
     std::optional<ChildProcess> roudi = StartRouDi(roudi_config, run_dir);
     std::vector<std::string> mapd_argv = {mapd};
     mapd_argv.insert(mapd_argv.end(), mapd_args.begin(), mapd_args.end());
     std::optional<ChildProcess> mapd_process;
     if (!no_mapd) {
       mapd_process = StartMapd(mapd_argv, run_dir);
+      mapd_pids.push_back(mapd_process->pid());
       Say("mapd started (pid " + std::to_string(mapd_process->pid()) + ")");
     }
     std::vector<std::string> roverd_argv = {roverd_sim, "--ipc", "roverd"};
@@ -137,6 +200,7 @@ int main(int argc, char** argv) {
       }
       if (restart_at && *restart_at < Time::Now()) {
         mapd_process = StartMapd(mapd_argv, run_dir);
+        mapd_pids.push_back(mapd_process->pid());
         ++restarts;
         restart_at.reset();
         Say("mapd restarted (pid " + std::to_string(mapd_process->pid()) + ")");
@@ -144,13 +208,24 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     if (mapd_process) {
-      const auto status = mapd_process->Terminate(Duration::Seconds(5));
+      // mapd finishes its submap, composes and exports the map on SIGTERM.
+      const auto status = mapd_process->Terminate(Duration::Seconds(60));
       Say("mapd stopped (" + status.Describe() + "), restarted " + std::to_string(restarts) +
           " times during the mission");
     }
     if (roudi) roudi->Terminate(Duration::Seconds(10));
     fs::remove(fs::path(run_dir) / "mapd.pid");
     if (!roverd_status->ok()) Say("roverd-sim " + roverd_status->Describe());
+    if (!evaluate_map.empty()) {
+      std::ifstream in(result_file);
+      std::string roverd_result((std::istreambuf_iterator<char>(in)),
+                                std::istreambuf_iterator<char>());
+      if (roverd_result.empty()) {
+        Say("roverd-sim wrote no RESULT line; no map evaluation");
+      } else {
+        EvaluateMap(roverd_result, evaluate_map, mapd_pids);
+      }
+    }
     return roverd_status->exited ? roverd_status->exit_code : 128 + roverd_status->signal;
   } catch (const std::exception& e) {
     Say(e.what());

@@ -3,6 +3,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <fstream>
+#include <sstream>
+
 #include <unistd.h>
 #include <cstdio>
 #include <exception>
@@ -38,6 +41,10 @@ int main(int argc, char** argv) {
   app.add_option("--config", config,
                  "board profile (YAML, e.g. firmware/config/sim.yaml): thread scheduling, health, "
                  "images, log service; its log folder is the default for --out");
+  std::string result_file;
+  app.add_option("--result-file", result_file,
+                 "write the RESULT line to this file instead of standard output (rover-launch "
+                 "adds the map's fields to it)");
   std::string images;
   app.add_option("--images", images,
                  "camera images in the log: none, thumbnails (cam0, ~188 px wide, 1 Hz; the "
@@ -71,7 +78,16 @@ int main(int argc, char** argv) {
   try {
     const rover::sim::MissionResult r = rover::sim::RunMission(options);
     if (tty) std::fprintf(stderr, "\r\033[K");
-    rover::sim::PrintMissionSummary(r, std::cout);
+    std::ostringstream summary;
+    rover::sim::PrintMissionSummary(r, summary);
+    std::string text = summary.str();
+    if (!result_file.empty()) {
+      // The RESULT line is the summary's last.
+      const std::size_t at = text.rfind("RESULT ");
+      std::ofstream(result_file) << text.substr(at);
+      text.erase(at);
+    }
+    std::cout << text << std::flush;
     return r.filter_initialised ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "\nroverd-sim: %s\n", e.what());
