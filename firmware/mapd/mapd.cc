@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/log/msgs/message_traits.h"
 #include "estimator/eskf/eskf_output.h"
 #include "firmware/mapd/submap_archive.h"
 
@@ -113,6 +114,8 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
                                std::string(topics::kStereoCalibrationTopic) + ": " + error);
     }
     pending_frame_ = std::make_unique<topics::StereoFrameMsg>();
+    traversability_ =
+        Advertise<topics::TraversabilityMsg>(transport, topics::kTraversabilityTopic, 1);
     archive_ = std::make_unique<SubmapArchive>(options_.output_stem, options_.robot_name,
                                                mapping::MapComposerOptions{});
   }
@@ -358,6 +361,12 @@ void Mapd::LogTraversability(int64_t stamp_ns) {
     }
   }
   archive_->LogTraversability(msg);
+  if (log::SerializedSize(msg) <= topics::TraversabilityMsg::kMaxCdrBytes) {
+    const bool sent = traversability_->PublishInPlace([&msg](topics::TraversabilityMsg& m) {
+      m.cdr_size = static_cast<uint32_t>(log::SerializeMessage(msg, m.cdr));
+    });
+    if (sent) ++stats_.grids_published;
+  }
 }
 
 void Mapd::FinishMappingSubmap() {

@@ -101,6 +101,7 @@ struct MapdStats {
   uint64_t octree_bytes = 0;      ///< serialised octomap_msgs/Octomap of finished submaps
   uint64_t cloud_bytes = 0;       ///< serialised sensor_msgs/PointCloud2 of finished submaps
   uint64_t obstacle_points = 0;
+  uint64_t grids_published = 0;
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
@@ -171,6 +172,7 @@ class Mapd {
   std::unique_ptr<ipc::Publisher<runtime::topics::FrameSwitchRequestMsg>> requests_;
   std::unique_ptr<ipc::Publisher<runtime::topics::MapdStatusMsg>> status_;
   std::unique_ptr<ipc::Subscriber<runtime::topics::StereoCalibrationMsg>> calibration_;
+  std::unique_ptr<ipc::Publisher<runtime::topics::TraversabilityMsg>> traversability_;
   /// 2 MB: one frame buffer, allocated once.
   std::unique_ptr<runtime::topics::StereoFrameMsg> frame_buffer_;
   /// The newest pair waiting for its estimates (mapping only).

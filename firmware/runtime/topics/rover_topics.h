@@ -33,6 +33,7 @@ inline constexpr std::string_view kFrameSwitchRequestTopic = "/mapd/frame_switch
 inline constexpr std::string_view kMapdStatusTopic = "/mapd/status";
 inline constexpr std::string_view kDiagnosticsTopic = "/roverd/diagnostics";
 inline constexpr std::string_view kStereoCalibrationTopic = "/roverd/stereo_calibration";
+inline constexpr std::string_view kTraversabilityTopic = "/mapd/traversability";
 
 /// One estimate of the local reference filter, in its current local frame.
 struct PoseMsg {
@@ -125,6 +126,18 @@ struct MapdStatusMsg {
 /// log's own message code (log::DeserializeMessage).
 struct DiagnosticsMsg {
   static constexpr std::size_t kMaxCdrBytes = 32 * 1024;
+  uint32_t version = kTopicsVersion;
+  uint32_t cdr_size = 0;
+  std::array<std::byte, kMaxCdrBytes> cdr;
+};
+
+/// mapd's robot-centred traversability grid: a nav_msgs/OccupancyGrid as
+/// ROS 2 CDR (the bytes mapd's log holds); 0..100 per cell, 65 at the
+/// step limit h_diff = h_max + Delta_d, -1 unknown. Published with history 1,
+/// so a planner that connects gets the latest grid at once.
+struct TraversabilityMsg {
+  /// A 200 x 200 grid and its header, in RouDi's 64 KiB pool with the chunk header.
+  static constexpr std::size_t kMaxCdrBytes = 60 * 1024;
   uint32_t version = kTopicsVersion;
   uint32_t cdr_size = 0;
   std::array<std::byte, kMaxCdrBytes> cdr;

@@ -5,13 +5,17 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 
 #include <octomap/OcTree.h>
 
 #include "core/ipc/in_process_transport.h"
+#include "core/log/msgs/message_traits.h"
+#include "core/log/msgs/nav_msgs.h"
 #include "firmware/mapd/mapd.h"
 #include "firmware/roverd/mapd_link.h"
 #include "mapping/compose/map_export.h"
@@ -126,6 +130,21 @@ TEST_F(MapdMappingTest, MapsPairsIntoSubmapsLogsThemAndExportsTheGlobalMap) {
   mapd->Shutdown();
   EXPECT_EQ(mapd->stats().submaps_archived, 2u);
   EXPECT_GT(mapd->stats().obstacle_points, 50u) << "the box is a step obstacle";
+  // The grid is published for a planner, as the log's OccupancyGrid bytes.
+  auto grids = transport_.MakeSubscriber<topics::TraversabilityMsg>(
+      T(topics::kTraversabilityTopic), {.queue_capacity = 1, .history_request = 1});
+  auto grid_msg = std::make_unique<topics::TraversabilityMsg>();
+  ASSERT_TRUE(grids->TryTake(grid_msg.get()));
+  log::nav_msgs::OccupancyGrid grid;
+  ASSERT_TRUE(log::DeserializeMessage(std::span(grid_msg->cdr.data(), grid_msg->cdr_size), &grid));
+  EXPECT_EQ(grid.info.width, 200u);
+  EXPECT_FLOAT_EQ(grid.info.resolution, 0.05f);
+  const auto occupied =
+      std::count_if(grid.data.begin(), grid.data.end(), [](int8_t v) { return v > 65; });
+  EXPECT_GT(occupied, 5) << "the box";
+  const auto level =
+      std::count_if(grid.data.begin(), grid.data.end(), [](int8_t v) { return v >= 0 && v < 30; });
+  EXPECT_GT(level, 1000) << "level ground";
 
   // The log: both submaps, with their octree and cloud, and grids.
   const mapping::SubmapLog log = mapping::ReadSubmapLog(mapd->log_path());
