@@ -9,6 +9,7 @@
 // (kept with ROVER_KEEP_TEST_TMP=1) can be traced back to its test.
 
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 namespace rover::testing {
@@ -36,6 +37,10 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+/// The whole of the file at `path` ("" if it cannot be read): output files
+/// of child processes, written logs.
+std::string ReadTextFile(const std::filesystem::path& path);
 
 }  // namespace rover::testing
 

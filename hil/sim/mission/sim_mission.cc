@@ -28,17 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-estimator::vo::CameraModel CameraModelOf(const StereoCameraOptions& cam,
-                                         const Eigen::Isometry3d& T_body_cam) {
-  estimator::vo::CameraModel m;
-  m.width_px = cam.width_px;
-  m.height_px = cam.height_px;
-  m.intrinsics = {cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px};
-  m.distortion = cam.DistortionCoeffs();
-  m.T_body_cam = T_body_cam;
-  return m;
-}
-
 // Latest filter output for the status line and the summary. Written on the
 // IMU thread (wait-free: a sequence counter around relaxed atomic fields),
 // read by the status thread.
@@ -132,6 +121,17 @@ std::string Fixed(double v, int digits) {
 }
 
 }  // namespace
+
+estimator::vo::CameraModel CameraModelOf(const StereoCameraOptions& cam,
+                                         const Eigen::Isometry3d& T_body_cam) {
+  estimator::vo::CameraModel m;
+  m.width_px = cam.width_px;
+  m.height_px = cam.height_px;
+  m.intrinsics = {cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px};
+  m.distortion = cam.DistortionCoeffs();
+  m.T_body_cam = T_body_cam;
+  return m;
+}
 
 MissionResult RunMission(const MissionOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();

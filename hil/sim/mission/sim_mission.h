@@ -13,6 +13,7 @@
 
 #include "firmware/roverd/roverd.h"
 #include "firmware/runtime/board/board_config.h"
+#include "hil/sim/render/stereo_camera.h"
 
 namespace rover::sim {
 
@@ -66,6 +67,11 @@ MissionResult RunMission(const MissionOptions& options);
 
 /// The summary, ending with the RESULT line of the command-line contract.
 void PrintMissionSummary(const MissionResult& result, std::ostream& out);
+
+/// The calibration roverd (and mapd, through roverd) uses for one of the
+/// simulator's cameras at `T_body_cam`.
+estimator::vo::CameraModel CameraModelOf(const StereoCameraOptions& camera,
+                                         const Eigen::Isometry3d& T_body_cam);
 
 }  // namespace rover::sim
 

@@ -29,13 +29,6 @@ namespace {
 namespace fs = std::filesystem;
 namespace msgs = log::rover_msgs;
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The pid in `path`, once it differs from `other` (0: any).
 pid_t WaitForPid(const fs::path& path, pid_t other, Duration timeout) {
   const Time deadline = Time::Now() + timeout;
@@ -85,25 +78,25 @@ TEST(MapdCrashTest, KillingMapdLeavesNoGapInTheImuLoopAndMapdResumesWithANewSubm
                 dir.path().string()},
        .output_file = output.string()});
   const pid_t first = WaitForPid(run_dir / "mapd.pid", 0, Duration::Seconds(30));
-  ASSERT_GT(first, 0) << ReadFile(output);
+  ASSERT_GT(first, 0) << testing::ReadTextFile(output);
   // Let the mission run until the first mapd has its submap (the status
   // line shows the filter in frame 1: the renderer's set-up and the
   // filter's standstill initialisation take a few seconds, more on a loaded
   // machine), then kill mapd without warning.
   const Time give_up = Time::Now() + Duration::Seconds(90);
-  while (ReadFile(output).find("mapd up, frame 1") == std::string::npos) {
-    ASSERT_LT(Time::Now(), give_up) << "no frame switch yet\n" << ReadFile(output);
+  while (testing::ReadTextFile(output).find("mapd up, frame 1") == std::string::npos) {
+    ASSERT_LT(Time::Now(), give_up) << "no frame switch yet\n" << testing::ReadTextFile(output);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   std::this_thread::sleep_for(std::chrono::seconds(1));
   const Time killed_at = Time::Now();
   ASSERT_EQ(::kill(first, SIGKILL), 0);
   const pid_t second = WaitForPid(run_dir / "mapd.pid", first, Duration::Seconds(10));
-  EXPECT_GT(second, 0) << "mapd was not restarted\n" << ReadFile(output);
+  EXPECT_GT(second, 0) << "mapd was not restarted\n" << testing::ReadTextFile(output);
 
   const auto status = launcher.WaitFor(Duration::Seconds(120));
-  ASSERT_TRUE(status.has_value()) << ReadFile(output);
-  const std::string text = ReadFile(output);
+  ASSERT_TRUE(status.has_value()) << testing::ReadTextFile(output);
+  const std::string text = testing::ReadTextFile(output);
   ASSERT_TRUE(status->ok()) << status->Describe() << "\n" << text;
   EXPECT_NE(text.find("mapd killed by signal 9"), std::string::npos) << text;
   EXPECT_NE(text.find("restarted 1 times"), std::string::npos) << text;

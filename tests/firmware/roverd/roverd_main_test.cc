@@ -18,13 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 struct RoverdRun {
   runtime::ExitStatus status;
   std::string output;
@@ -38,7 +31,7 @@ RoverdRun RunRoverd(const fs::path& dir, const std::string& yaml) {
       runtime::ChildProcess::Spawn({.argv = {ROVER_ROVERD, "--config", config.string(), "--no-ipc"},
                                     .output_file = output.string()});
   const auto status = p.WaitFor(Duration::Seconds(300));
-  return {status.value_or(p.Terminate(Duration::Seconds(1))), ReadFile(output)};
+  return {status.value_or(p.Terminate(Duration::Seconds(1))), testing::ReadTextFile(output)};
 }
 
 std::string Dataset() {

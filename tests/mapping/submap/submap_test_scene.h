@@ -21,35 +21,9 @@
 #include <opencv2/core.hpp>
 
 #include "mapping/depth/depth_image.h"
+#include "tests/mapping/mapping_test_head.h"
 
 namespace rover::mapping::testing {
-
-/// The simulator's head (f = 460 px, b = 0.11 m), scaled down by `factor`.
-inline RectifiedStereo SimulatorHead(int factor = 1) {
-  RectifiedStereo s;
-  s.width_px = 752 / factor;
-  s.height_px = 480 / factor;
-  s.focal_px = 460.0 / factor;
-  s.cx_px = s.width_px / 2.0;
-  s.cy_px = s.height_px / 2.0;
-  s.baseline_m = 0.11;
-  return s;
-}
-
-/// Camera at (x, y, height) of a gravity frame (z up), heading `yaw_rad`
-/// from +x, pitched down by `pitch_deg`; OpenCV camera axes.
-inline Eigen::Isometry3d CameraPose(double x_m, double y_m, double height_m, double yaw_rad,
-                                    double pitch_deg) {
-  Eigen::Matrix3d R0;
-  R0 << 0, 0, 1,  //
-      -1, 0, 0,   //
-      0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) *
-               Eigen::AngleAxisd(pitch_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()) * R0;
-  T.translation() = Eigen::Vector3d(x_m, y_m, height_m);
-  return T;
-}
 
 struct Rock {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();

@@ -13,32 +13,16 @@
 #include <opencv2/core.hpp>
 
 #include "mapping/depth/depth_image.h"
+#include "tests/mapping/mapping_test_head.h"
 
 namespace rover::mapping::testing {
 
-/// The simulator's 752x480 head (f = 460 px, b = 0.11 m) scaled down by
-/// `factor` (4: 188x120).
-inline RectifiedStereo SmallHead(int factor = 4) {
-  RectifiedStereo s;
-  s.width_px = 752 / factor;
-  s.height_px = 480 / factor;
-  s.focal_px = 460.0 / factor;
-  s.cx_px = s.width_px / 2.0;
-  s.cy_px = s.height_px / 2.0;
-  s.baseline_m = 0.11;
-  return s;
-}
+/// The simulator's head scaled down by `factor` (4: 188x120).
+inline RectifiedStereo SmallHead(int factor = 4) { return SimulatorHead(factor); }
 
-/// Camera at (0, 0, height) pitched down by `pitch_deg`, OpenCV axes.
+/// Camera at (0, 0, height) looking along +x, pitched down by `pitch_deg`.
 inline Eigen::Isometry3d CameraPose(double height_m, double pitch_deg) {
-  Eigen::Matrix3d R0;
-  R0 << 0, 0, 1,  //
-      -1, 0, 0,   //
-      0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(pitch_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()) * R0;
-  T.translation() = Eigen::Vector3d(0.0, 0.0, height_m);
-  return T;
+  return CameraPose(0.0, 0.0, height_m, 0.0, pitch_deg);
 }
 
 /// The disparity image (CV_16S, 16 per px) of terrain `height(x, y)`, ray

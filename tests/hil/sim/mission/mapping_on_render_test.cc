@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "firmware/mapd/local_mapper.h"
+#include "hil/sim/mission/sim_mission.h"
 #include "hil/sim/motion/rover_trajectory.h"
 #include "hil/sim/render/stereo_renderer.h"
 #include "hil/sim/scenario/scenario.h"
@@ -18,16 +19,6 @@
 
 namespace rover::sim {
 namespace {
-
-estimator::vo::CameraModel CameraOf(const StereoCameraOptions& cam, const Eigen::Isometry3d& T) {
-  estimator::vo::CameraModel m;
-  m.width_px = cam.width_px;
-  m.height_px = cam.height_px;
-  m.intrinsics = {cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px};
-  m.distortion = cam.DistortionCoeffs();
-  m.T_body_cam = T;
-  return m;
-}
 
 bool IsObstacle(const ObstacleGrid& g, int ix, int iy) {
   if (ix < 0 || iy < 0 || ix >= g.cols || iy >= g.rows) return false;
@@ -56,8 +47,8 @@ class MappingOnRenderTest : public ::testing::Test {
   }
 
   MappingOnRenderTest()
-      : mapper_({}, CameraOf(scenario_->camera, scenario_->camera.T_body_cam0),
-                CameraOf(scenario_->camera, scenario_->camera.T_body_cam1())) {}
+      : mapper_({}, CameraModelOf(scenario_->camera, scenario_->camera.T_body_cam0),
+                CameraModelOf(scenario_->camera, scenario_->camera.T_body_cam1())) {}
 
   Eigen::Isometry3d BodyAt(double t_s) const {
     const TrajectorySample s = trajectory_->Evaluate(t_s);

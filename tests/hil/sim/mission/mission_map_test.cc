@@ -22,13 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // key=value fields of the last RESULT line of `text`.
 std::map<std::string, std::string> LastResult(const std::string& text) {
   std::map<std::string, std::string> fields;
@@ -58,8 +51,8 @@ TEST(MissionMapTest, ShortMissionMapMeetsTheQualityAndBandwidthTargets) {
                 "short", "--seed", "1", "--out", dir.path().string()},
        .output_file = output.string()});
   const auto status = launcher.WaitFor(Duration::Seconds(400));
-  ASSERT_TRUE(status.has_value()) << ReadFile(output);
-  const std::string text = ReadFile(output);
+  ASSERT_TRUE(status.has_value()) << testing::ReadTextFile(output);
+  const std::string text = testing::ReadTextFile(output);
   ASSERT_TRUE(status->ok()) << status->Describe() << "\n" << text;
   const auto r = LastResult(text);
   for (const char* key : {"map_precision", "map_recall", "obstacle_precision", "obstacle_recall",
