@@ -4,6 +4,13 @@
 
 namespace rover {
 
+Eigen::Isometry3d GravityAlignedTransform(const Eigen::Vector3d& p_m, double yaw_rad) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Rz(yaw_rad);
+  T.translation() = p_m;
+  return T;
+}
+
 Eigen::Matrix3d Rz(double yaw_rad) {
   const double c = std::cos(yaw_rad);
   const double s = std::sin(yaw_rad);

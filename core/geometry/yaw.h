@@ -17,11 +17,16 @@
 // x axis is vertical (pitch = +-90 deg), which a ground rover never reaches.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace rover {
 
 /// Rotation by yaw_rad about the z axis (counter-clockwise seen from +z).
 Eigen::Matrix3d Rz(double yaw_rad);
+
+/// A transform between two gravity-aligned frames (a frame switch, a submap
+/// origin): translation p_m, then rotation Rz(yaw_rad).
+Eigen::Isometry3d GravityAlignedTransform(const Eigen::Vector3d& p_m, double yaw_rad);
 
 /// Heading of R_world_body in radians, in [-pi, pi]: the angle from the world x
 /// axis to the horizontal projection of the body x axis, atan2(R(1,0), R(0,0)).

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/geometry/yaw.h"
 #include "core/log/msgs/rover_msgs.h"
 #include "firmware/mapd/mapd.h"
 #include "mapping/compose/map_export.h"
@@ -12,13 +13,10 @@
 namespace rover::mapd {
 namespace {
 
-// The switch record as a transform: the new frame seen from the old one
-// (x, y, z, yaw; frames stay gravity-aligned).
+// The switch record as a transform: the new frame seen from the old one.
 Eigen::Isometry3d TransformOf(const runtime::topics::FrameSwitchMsg& r) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(r.yaw_old_new_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() = Eigen::Vector3d(r.p_old_new_m[0], r.p_old_new_m[1], r.p_old_new_m[2]);
-  return T;
+  return GravityAlignedTransform(
+      Eigen::Vector3d(r.p_old_new_m[0], r.p_old_new_m[1], r.p_old_new_m[2]), r.yaw_old_new_rad);
 }
 
 }  // namespace

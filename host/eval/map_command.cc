@@ -86,10 +86,7 @@ MissionFacts ReadMission(const std::string& path) {
 
 // Position and yaw only: local frames are gravity-aligned.
 Eigen::Isometry3d FourDof(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Rz(YawOf(R));
-  T.translation() = p;
-  return T;
+  return GravityAlignedTransform(p, YawOf(R));
 }
 
 std::string Num(double v, int digits) {

@@ -1,14 +1,14 @@
 #include "host/log/submap_chain.h"
 
+#include "core/geometry/yaw.h"
+
 namespace rover::host {
 
 Eigen::Isometry3d SubmapOriginTransform(const log::rover_msgs::SubmapInfo& info) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() =
-      Eigen::AngleAxisd(info.yaw_previous_origin_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() = Eigen::Vector3d(info.p_previous_origin_m[0], info.p_previous_origin_m[1],
-                                    info.p_previous_origin_m[2]);
-  return T;
+  return GravityAlignedTransform(
+      Eigen::Vector3d(info.p_previous_origin_m[0], info.p_previous_origin_m[1],
+                      info.p_previous_origin_m[2]),
+      info.yaw_previous_origin_rad);
 }
 
 std::map<uint32_t, Eigen::Isometry3d> ChainSubmapOrigins(

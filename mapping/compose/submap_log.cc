@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "core/geometry/yaw.h"
 #include "core/log/mcap/mcap_reader.h"
 #include "core/log/msgs/estimator_msgs.h"
 #include "core/log/msgs/message_traits.h"
@@ -36,10 +37,8 @@ log::McapReader OpenLog(const std::string& path) {
 }
 
 Eigen::Isometry3d SwitchTransform(const log::rover_msgs::EstimatorFrameSwitch& s) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(s.yaw_old_new_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() = Eigen::Vector3d(s.p_old_new_m[0], s.p_old_new_m[1], s.p_old_new_m[2]);
-  return T;
+  return GravityAlignedTransform(
+      Eigen::Vector3d(s.p_old_new_m[0], s.p_old_new_m[1], s.p_old_new_m[2]), s.yaw_old_new_rad);
 }
 
 }  // namespace

@@ -491,3 +491,18 @@ TEST_F(GeometryTest, YawIsEquivariantUnderWorldYaw) {
 
 }  // namespace
 }  // namespace rover
+
+namespace rover {
+namespace {
+
+TEST(GravityAlignedTransformTest, RotatesAboutZThenTranslates) {
+  const Eigen::Isometry3d T = GravityAlignedTransform(Eigen::Vector3d(1.0, 2.0, 0.5), M_PI / 2);
+  const Eigen::Vector3d p = T * Eigen::Vector3d(1.0, 0.0, 0.3);
+  EXPECT_NEAR(p.x(), 1.0, 1e-12);  // x turned onto +y
+  EXPECT_NEAR(p.y(), 3.0, 1e-12);
+  EXPECT_NEAR(p.z(), 0.8, 1e-12);  // heights pass through
+  EXPECT_NEAR(YawOf(T.linear()), M_PI / 2, 1e-12);
+}
+
+}  // namespace
+}  // namespace rover
