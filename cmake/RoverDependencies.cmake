@@ -25,6 +25,10 @@ if(NOT ROVER_FUZZ)
   find_package(OpenSSL REQUIRED COMPONENTS Crypto)
   # sd_notify (readiness, watchdog, status) of the firmware processes.
   pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
+  # Cameras on GigE Vision / USB3 Vision (drivers/camera, Aravis 0.8) and
+  # GPIO lines through the character device (drivers/gpio, libgpiod v1).
+  pkg_check_modules(ARAVIS REQUIRED IMPORTED_TARGET aravis-0.8)
+  pkg_check_modules(GPIOD REQUIRED IMPORTED_TARGET libgpiod)
   if(ROVER_BUILD_TESTS)
     find_package(GTest REQUIRED)
     include(GoogleTest)

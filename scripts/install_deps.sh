@@ -42,6 +42,15 @@ DEBIAN_PACKAGES=(
   rt-tests                   # cyclictest: reference wake-up latency for scripts/rt_latency.sh
   libsystemd-dev             # sd_notify: roverd's systemd watchdog and readiness notification
   libcpp-httplib-dev         # HTTP log service on the board and `rover-log list/download` (cpp-httplib 0.11)
+  qemu-system-x86            # HIL bench (hil/bench): boots Debian's kernel under TCG with real vcan/vivid
+  linux-image-amd64          # HIL bench: the guest kernel and its vcan, can-raw, can-isotp, vivid, 9p modules
+  busybox-static             # HIL bench: the guest's initramfs userland (/init, insmod, mount)
+  iproute2                   # HIL bench: `ip link add vcan0 type vcan` inside the guest (run from the host fs)
+  can-utils                  # candump/cansend for poking the bench's vcan0 by hand
+  aravis-tools               # arv-fake-gv-camera-0.8: a real GigE Vision device on loopback for the Aravis tests
+  libaravis-dev              # Aravis 0.8: GigE Vision / USB3 Vision cameras (drivers/camera)
+  libgpiod-dev               # libgpiod v1: GPIO trigger output and edge events (drivers/gpio)
+  libusb-1.0-0-dev           # required by aravis-0.8.pc (pkg-config fails without it)
   libssl-dev                 # SHA-256 of served logs (OpenSSL libcrypto EVP), also needed by cpp-httplib
 )
 
