@@ -118,8 +118,8 @@ int RunCan(const CanArgs& args) {
   }
   std::printf("sent %llu frames of '%s' to %s (%llu refused by the kernel)\n",
               static_cast<unsigned long long>(sent), scenario.name.c_str(), args.interface.c_str(),
-              static_cast<unsigned long long>(bus.send_failures()));
-  return bus.send_failures() == 0 ? 0 : 1;
+              static_cast<unsigned long long>(bus.stats().send_failures));
+  return bus.stats().send_failures == 0 ? 0 : 1;
 }
 
 }  // namespace
