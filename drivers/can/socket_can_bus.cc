@@ -101,6 +101,12 @@ SocketCanBus::SocketCanBus(const SocketCanOptions& options)
     k.can_mask = f.mask | CAN_EFF_FLAG | CAN_RTR_FLAG;
     std::memcpy(kernel_filters_.data() + i * sizeof k, &k, sizeof k);
   }
+  // Checked first: "no such interface" is the error a user meets most, and
+  // it holds even where the kernel has no CAN support at all.
+  if (if_nametoindex(options_.interface.c_str()) == 0) {
+    throw CanError("SocketCAN " + options_.interface + ": no such interface (" +
+                   std::strerror(errno) + "); `ip link` lists the interfaces");
+  }
   const char* step = "";
   fd_ = OpenSocket(&step);
   if (fd_ < 0) {

@@ -1,6 +1,7 @@
 #include "drivers/imu/xsens_mti_driver.h"
 
 #include <poll.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -285,7 +286,17 @@ ReadStatus XsensMtiDriver::Read(ImuSample* sample, Duration timeout) {
     }
     bool timed_out = false;
     if (!ReadInto(deadline, &timed_out)) {
+      // A port that hung up (device unplugged, pty closed) stays readable
+      // with an error: without a wait the caller's loop would spin. One
+      // error per timeout is enough to notice, and leaves the CPU to others.
       ++stats_.read_errors;
+      const Duration left = deadline - Time::Now();
+      if (left > Duration::Zero()) {
+        const int64_t ns = left.nanoseconds();
+        const timespec pause{static_cast<time_t>(ns / 1'000'000'000),
+                             static_cast<long>(ns % 1'000'000'000)};
+        clock_nanosleep(CLOCK_MONOTONIC, 0, &pause, nullptr);
+      }
       return ReadStatus::kError;
     }
     if (timed_out) {

@@ -19,6 +19,7 @@
 #include <memory>
 #include <thread>
 
+#include "firmware/roverd/hardware_board.h"
 #include "firmware/roverd/replay_board.h"
 #include "firmware/roverd/roverd_process.h"
 #include "firmware/roverd/roverd_summary.h"
@@ -44,8 +45,9 @@ std::string LogName() {
 int main(int argc, char** argv) {
   CLI::App app{
       "roverd: the rover's real-time process. Reads the board profile (--config), starts the\n"
-      "drivers it names (profile replay: a EuRoC-layout dataset; profile sim runs as\n"
-      "roverd-sim), and runs the local reference filter on the IMU thread with stereo VO,\n"
+      "drivers it names (profile hardware: the board's IMU, cameras and CAN bus; profile\n"
+      "replay: a EuRoC-layout dataset; profile sim runs as roverd-sim), and runs the local "
+      "reference filter on the IMU thread with stereo VO,\n"
       "wheel odometry, the flight log in log.folder, the health report, the mapd link over\n"
       "iceoryx and the HTTP log service, until the sensors end or SIGTERM/SIGINT.\n"};
   std::string config = rover::runtime::DefaultBoardConfigPath();
@@ -56,30 +58,37 @@ int main(int argc, char** argv) {
 
   rover::runtime::BoardConfig board;
   std::unique_ptr<rover::roverd::ReplayBoard> replay;
+  std::unique_ptr<rover::roverd::HardwareBoard> hardware;
   try {
     board = rover::runtime::BoardConfig::LoadFile(config);
-    if (board.board.profile != rover::runtime::BoardProfile::kReplay) {
-      std::fprintf(stderr,
-                   "roverd: %s: board.profile %s has no drivers in roverd (the simulator's "
-                   "profile runs as roverd-sim); expected replay\n",
-                   config.c_str(),
-                   std::string(rover::runtime::BoardProfileName(board.board.profile)).c_str());
-      return 78;
+    switch (board.board.profile) {
+      case rover::runtime::BoardProfile::kReplay:
+        replay = std::make_unique<rover::roverd::ReplayBoard>(*board.replay);
+        break;
+      case rover::runtime::BoardProfile::kHardware:
+        hardware = std::make_unique<rover::roverd::HardwareBoard>(*board.hardware);
+        break;
+      case rover::runtime::BoardProfile::kSim:
+        std::fprintf(stderr,
+                     "roverd: %s: board.profile sim has no drivers in roverd (the simulator's "
+                     "profile runs as roverd-sim); expected hardware or replay\n",
+                     config.c_str());
+        return 78;
     }
-    replay = std::make_unique<rover::roverd::ReplayBoard>(*board.replay);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "roverd: %s\n", e.what());
     return 78;
   }
+  const std::string profile(rover::runtime::BoardProfileName(board.board.profile));
   try {
-    rover::roverd::RoverdOptions options = replay->options();
+    rover::roverd::RoverdOptions options = replay ? replay->options() : hardware->options();
     rover::roverd::ApplyBoard(board, &options);
 
     rover::roverd::RoverdProcessOptions process;
     process.log_path = (std::filesystem::path(board.log.folder) / LogName()).string();
     process.metadata["board"] = {{"name", board.board.name},
-                                 {"profile", "replay"},
-                                 {"dataset", board.replay->dataset},
+                                 {"profile", profile},
+                                 {"source", replay ? board.replay->dataset : "devices"},
                                  {"config", config}};
     if (!no_ipc) process.ipc_runtime_name = "roverd";
     process.roudi_wait = rover::Duration::FromSeconds(board.ipc.roudi_wait_s);
@@ -91,7 +100,8 @@ int main(int argc, char** argv) {
     process.lock_memory = board.realtime.lock_memory;
     process.imu_thread = board.threads.imu;
 
-    rover::roverd::RoverdProcess roverd(options, replay->drivers(), process);
+    rover::roverd::RoverdProcess roverd(options, replay ? replay->drivers() : hardware->drivers(),
+                                        process);
     std::signal(SIGTERM, OnSignal);
     std::signal(SIGINT, OnSignal);
     // Signals only set a flag; this relay turns it into Stop().
@@ -102,8 +112,15 @@ int main(int argc, char** argv) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
       }
     });
-    std::fprintf(stderr, "roverd: %s (%s) replaying %s, logging to %s\n", board.board.name.c_str(),
-                 config.c_str(), board.replay->dataset.c_str(), process.log_path.c_str());
+    if (replay) {
+      std::fprintf(stderr, "roverd: %s (%s) replaying %s, logging to %s\n",
+                   board.board.name.c_str(), config.c_str(), board.replay->dataset.c_str(),
+                   process.log_path.c_str());
+    } else {
+      std::fprintf(stderr, "roverd: %s (%s) on its devices, logging to %s\n%s",
+                   board.board.name.c_str(), config.c_str(), process.log_path.c_str(),
+                   hardware->description().c_str());
+    }
     rover::roverd::RoverdProcessResult result;
     try {
       result = roverd.Run();
@@ -115,7 +132,9 @@ int main(int argc, char** argv) {
     done.store(true);
     relay.join();
     std::cout << "roverd " << board.board.name << ": " << result.stats.imu_samples
-              << " IMU samples replayed from " << board.replay->dataset << "\n";
+              << " IMU samples "
+              << (replay ? "replayed from " + board.replay->dataset : std::string("from the IMU"))
+              << "\n";
     rover::roverd::PrintRoverdStats(result.stats, result.mapd_link, std::cout);
     std::cout << "  log     " << process.log_path << " (" << result.log.written << " records, "
               << result.log.dropped << " dropped); replay it with `rover replay "

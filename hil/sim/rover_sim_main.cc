@@ -12,9 +12,11 @@
 
 #include "drivers/can/socket_can_bus.h"
 #include "hil/sim/dataset/dataset_generator.h"
+#include "hil/sim/devices/simulated_mti.h"
 #include "hil/sim/imu_mission.h"
 #include "hil/sim/live/sim_can_bus.h"
 #include "hil/sim/scenario/scenario.h"
+#include "hil/sim/sensors/imu_model.h"
 
 namespace {
 
@@ -122,6 +124,79 @@ int RunCan(const CanArgs& args) {
   return bus.stats().send_failures == 0 ? 0 : 1;
 }
 
+struct MtiArgs {
+  std::string scenario;
+  std::string link;
+  uint64_t seed = 1;
+  double max_duration_s = 0.0;
+  double wait_s = 60.0;
+};
+
+// A simulated Xsens MTi on a pty pair (hil/sim/devices) streaming the
+// simulator's IMU along a scenario's route, for roverd's Xsens driver on the
+// HIL bench: the driver configures it like the real device, then it streams
+// MTData2 for the route's duration (or --max-duration-s) and goes quiet.
+int RunMti(const MtiArgs& args) {
+  namespace sim = rover::sim;
+  const sim::Scenario scenario = sim::LoadScenario(
+      sim::FindScenario(sim::DefaultScenarioDir(), args.scenario), sim::DefaultSimConfigDir());
+  const sim::World world = sim::World::Generate(scenario.world, args.seed);
+  const sim::RoverTrajectory trajectory(scenario.route, world.terrain);
+  const double duration_s = args.max_duration_s > 0
+                                ? std::min(args.max_duration_s, trajectory.duration_s())
+                                : trajectory.duration_s();
+  sim::ImuModelOptions imu = scenario.imu;
+  imu.seed = scenario.imu.seed ^ (args.seed * 0x9E3779B97F4A7C15ULL);  // as `generate` seeds it
+  sim::ImuModel model(imu, rover::Time::Zero());
+  sim::SimulatedMtiOptions options;
+  options.seed = args.seed;
+  options.packet_source = [&](uint64_t, int) {
+    // One model sample per packet, in order: the route's IMU at the model's
+    // rate (the driver must configure the scenario's rate, checked below).
+    const rover::drivers::ImuSample s = model.Next(trajectory);
+    rover::drivers::MtData2Packet p;
+    for (int i = 0; i < 3; ++i) {
+      p.acceleration_m_s2[static_cast<std::size_t>(i)] =
+          static_cast<float>(s.linear_acceleration_m_s2[i]);
+      p.rate_of_turn_rad_s[static_cast<std::size_t>(i)] =
+          static_cast<float>(s.angular_velocity_rad_s[i]);
+    }
+    return p;
+  };
+  sim::SimulatedMti mti(options);
+  std::error_code ignored;
+  std::filesystem::remove(args.link, ignored);
+  std::filesystem::create_symlink(mti.port(), args.link);
+  std::printf(
+      "simulated MTi on %s (%s), scenario '%s' (%.1f s of IMU at %.0f Hz); waiting for "
+      "the driver to configure it\n",
+      mti.port().c_str(), args.link.c_str(), scenario.name.c_str(), duration_s, imu.rate_hz);
+  std::fflush(stdout);
+  const rover::Time wait_end = rover::Time::Now() + rover::Duration::FromSeconds(args.wait_s);
+  while (!mti.measuring() && rover::Time::Now() < wait_end) usleep(10'000);
+  int status = 0;
+  if (!mti.measuring()) {
+    std::fprintf(stderr, "rover-sim mti: no driver configured the device within %.0f s\n",
+                 args.wait_s);
+    status = 1;
+  } else if (std::abs(mti.rate_hz() - imu.rate_hz) > 0.5) {
+    std::fprintf(stderr, "rover-sim mti: the driver configured %d Hz; scenario '%s' has %.0f Hz\n",
+                 mti.rate_hz(), scenario.name.c_str(), imu.rate_hz);
+    status = 1;
+  } else {
+    const rover::Time end = rover::Time::Now() + rover::Duration::FromSeconds(duration_s);
+    while (rover::Time::Now() < end) usleep(20'000);
+    mti.StopStreaming();
+    usleep(500'000);  // let the reader drain the pty
+  }
+  const sim::SimulatedMtiStats stats = mti.stats();
+  std::printf("sent %llu MTData2 packets of '%s' on %s\n",
+              static_cast<unsigned long long>(stats.packets), scenario.name.c_str(),
+              args.link.c_str());
+  std::filesystem::remove(args.link, ignored);
+  return status;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -192,9 +267,23 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   can->add_flag("--lockstep", can_args.lockstep, "send as fast as possible, not in real time");
 
+  MtiArgs mti_args;
+  auto* mti = app.add_subcommand(
+      "mti",
+      "Simulate an Xsens MTi on a pty pair: answers the Xbus configuration, then streams the "
+      "scenario's IMU as MTData2 (for roverd's Xsens driver on the HIL bench)");
+  mti->add_option("--scenario", mti_args.scenario, "scenario name")->required();
+  mti->add_option("--link", mti_args.link, "symlink created to the pty's device side")->required();
+  mti->add_option("--seed", mti_args.seed, "world and IMU seed")->capture_default_str();
+  mti->add_option("--max-duration-s", mti_args.max_duration_s, "stream at most this long")
+      ->check(CLI::PositiveNumber);
+  mti->add_option("--wait-s", mti_args.wait_s, "give up when no driver configures it this long")
+      ->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
 
   try {
+    if (*mti) return RunMti(mti_args);
     if (*can) return RunCan(can_args);
     if (*list) return RunList(std::cout);
     if (*generate) return RunGenerate(generate_args);

@@ -57,6 +57,21 @@ Problem ReplayProblem(BoardProfile profile, bool has_replay) {
   return std::nullopt;
 }
 
+Problem HardwareProblem(BoardProfile profile, bool has_hardware) {
+  const bool wants = profile == BoardProfile::kHardware;
+  if (wants && !has_hardware) {
+    return std::make_pair(std::string("hardware"),
+                          "expected a hardware section (hardware: {calibration: ..., imu: ...}) "
+                          "with board.profile hardware, found none");
+  }
+  if (!wants && has_hardware) {
+    return std::make_pair(std::string("hardware"),
+                          "expected no hardware section with board.profile " +
+                              std::string(BoardProfileName(profile)) + ", found one");
+  }
+  return std::nullopt;
+}
+
 struct NamedThread {
   const char* key;
   const RtThreadOptions* options;
@@ -82,6 +97,10 @@ Problem FindProblem(const BoardConfig& c) {
                               " characters of [A-Za-z0-9_-], found \"" + name + "\"");
   }
   if (Problem p = ReplayProblem(c.board.profile, c.replay.has_value())) return p;
+  if (Problem p = HardwareProblem(c.board.profile, c.hardware.has_value())) return p;
+  if (c.hardware) {
+    if (auto p = c.hardware->Problem()) return p;
+  }
   if (c.replay && c.replay->dataset.empty()) {
     return std::make_pair(std::string("replay.dataset"),
                           "expected the folder of a EuRoC-layout dataset, found an empty path");
@@ -215,6 +234,8 @@ std::string_view BoardProfileName(BoardProfile profile) {
       return "sim";
     case BoardProfile::kReplay:
       return "replay";
+    case BoardProfile::kHardware:
+      return "hardware";
   }
   return "?";
 }
@@ -247,11 +268,18 @@ BoardConfig BoardConfig::Load(const ConfigNode& root) {
 
   const ConfigNode board = root.Child("board");
   c.board.name = board.Get<std::string>("name");
-  c.board.profile = board.GetEnum<BoardProfile>(
-      "profile", {{"sim", BoardProfile::kSim}, {"replay", BoardProfile::kReplay}});
+  c.board.profile = board.GetEnum<BoardProfile>("profile", {{"sim", BoardProfile::kSim},
+                                                            {"replay", BoardProfile::kReplay},
+                                                            {"hardware", BoardProfile::kHardware}});
   // Before reading the section, so a stray one is reported as such.
   if (Problem p = ReplayProblem(c.board.profile, root.Has("replay"))) {
     root.Fail(p->first, p->second);
+  }
+  if (Problem p = HardwareProblem(c.board.profile, root.Has("hardware"))) {
+    root.Fail(p->first, p->second);
+  }
+  if (c.board.profile == BoardProfile::kHardware) {
+    c.hardware = BoardHardwareOptions::Load(root.Child("hardware"));
   }
   if (c.board.profile == BoardProfile::kReplay) {
     const ConfigNode replay = root.Child("replay");

@@ -33,6 +33,7 @@
 #include <string_view>
 
 #include "core/config/config.h"
+#include "firmware/runtime/board/board_hardware_options.h"
 #include "firmware/runtime/health/health_options.h"
 #include "firmware/runtime/log_service/log_service_options.h"
 #include "firmware/runtime/rt/rt_setup.h"
@@ -44,11 +45,12 @@ namespace rover::runtime {
 /// enumerator, its name in BoardConfig::Load and BoardProfileName, and, if
 /// it needs settings, a section named like the profile (as `replay`).
 enum class BoardProfile {
-  kSim,     ///< "sim": the simulator's drivers (roverd-sim).
-  kReplay,  ///< "replay": a recorded EuRoC-layout dataset replayed as sensors.
+  kSim,       ///< "sim": the simulator's drivers (roverd-sim).
+  kReplay,    ///< "replay": a recorded EuRoC-layout dataset replayed as sensors.
+  kHardware,  ///< "hardware": the board's real devices (section `hardware`).
 };
 
-/// "sim", "replay": the name used in the YAML file.
+/// "sim", "replay", "hardware": the name used in the YAML file.
 std::string_view BoardProfileName(BoardProfile profile);
 
 /// What the flight log keeps of the camera images.
@@ -151,6 +153,8 @@ struct BoardConfig {
   BoardIdentity board;
   /// Present iff board.profile is kReplay.
   std::optional<BoardReplayOptions> replay;
+  /// Present iff board.profile is kHardware.
+  std::optional<BoardHardwareOptions> hardware;
   BoardThreadOptions threads;
   BoardRealtimeOptions realtime;
   BoardLogOptions log;

@@ -305,6 +305,11 @@ void SimulatedMti::SendPacket() {
   const uint64_t k = next_packet_++;
   const int rate = rate_hz_.load();
   drivers::MtData2Packet packet = PacketAt(options_.seed, k, rate);
+  if (options_.packet_source) {
+    const drivers::MtData2Packet measured = options_.packet_source(k, rate);
+    packet.acceleration_m_s2 = measured.acceleration_m_s2;
+    packet.rate_of_turn_rad_s = measured.rate_of_turn_rad_s;
+  }
   packet.packet_counter = static_cast<uint16_t>(options_.first_packet_counter + k);
   packet.sample_time_fine = measurement_ticks_ + packet.sample_time_fine;
   packet.has_packet_counter = configured_[kCounter];

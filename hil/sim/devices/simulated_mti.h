@@ -8,6 +8,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <random>
 #include <span>
@@ -36,6 +37,11 @@ struct SimulatedMtiOptions {
   uint32_t first_sample_time_fine = 0;  ///< SampleTimeFine at power-up (construction)
   /// The device clock runs this much fast against CLOCK_MONOTONIC.
   double clock_drift_ppm = 0.0;
+  /// The measurement of packet k of a measurement at `rate_hz` (counter and
+  /// sample time are the device's own); called on the device thread, in
+  /// order of k. Empty: PacketAt() (smooth motion plus seeded noise). `rover-sim
+  /// mti` sets it to the simulator's IMU along a scenario's route.
+  std::function<drivers::MtData2Packet(uint64_t k, int rate_hz)> packet_source{};
 
   // Fault injection, decided per packet from the seeded stream.
   double drop_probability = 0.0;     ///< packet never sent (a PacketCounter gap)

@@ -21,8 +21,19 @@ TEST(SocketCanBusTest, MissingInterfaceIsAClearError) {
 }
 
 TEST(SocketCanBusTest, OverlongNameIsRejectedBeforeTheKernelSeesIt) {
-  EXPECT_THROW(SocketCanBus("an-interface-name-far-too-long"), CanError);
-  EXPECT_THROW(SocketCanBus(""), CanError);
+  EXPECT_THROW(SocketCanBus("an-interface-name-far-too-long"), std::invalid_argument);
+  EXPECT_THROW(SocketCanBus(""), std::invalid_argument);
+}
+
+TEST(SocketCanBusTest, OptionsAreValidated) {
+  SocketCanOptions o;
+  o.interface = "can0";
+  o.filters = {CanFilter{0x800, 0x7FF, false}};
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+  o.filters = SocketCanOptions::WheelDriveFilters();
+  EXPECT_NO_THROW(o.Validate());
+  o.reopen_backoff_max = Duration::Milliseconds(1);
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
 }
 
 }  // namespace

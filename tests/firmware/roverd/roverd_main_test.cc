@@ -3,6 +3,8 @@
 // log must replay bit-exactly; unusable profiles exit with 78 (EX_CONFIG),
 // which the unit does not restart.
 
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -70,7 +72,15 @@ TEST(RoverdMainTest, UnusableProfilesExitWithExConfig) {
   const rover::testing::TempDir dir;
   RoverdRun run = RunRoverd(dir.path(), "board: {name: sim, profile: sim}\nlog: {folder: /tmp}\n");
   EXPECT_EQ(run.status.exit_code, 78) << run.output;
-  EXPECT_NE(run.output.find("expected replay"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("expected hardware or replay"), std::string::npos) << run.output;
+  // Hardware: a device that is not there is named, before any thread starts.
+  const char* source = std::getenv("ROVER_SOURCE_DIR");
+  run = RunRoverd(dir.path(), "board: {name: b, profile: hardware}\nhardware: {calibration: " +
+                                  std::string(source != nullptr ? source : ".") +
+                                  "/firmware/config/bench_calibration, imu: {driver: xsens, "
+                                  "device: /dev/rover-no-such-tty}}\nlog: {folder: /tmp}\n");
+  EXPECT_EQ(run.status.exit_code, 78) << run.output;
+  EXPECT_NE(run.output.find("/dev/rover-no-such-tty"), std::string::npos) << run.output;
   run = RunRoverd(dir.path(),
                   "board: {name: b, profile: replay}\nreplay: {dataset: /nonexistent}\n"
                   "log: {folder: /tmp}\n");

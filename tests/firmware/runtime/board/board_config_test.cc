@@ -243,9 +243,9 @@ TEST(BoardConfigTest, LogFolderIsRequired) {
 
 TEST(BoardConfigTest, BoardSectionIsRequiredAndChecked) {
   EXPECT_THAT(LoadError("log: {folder: /tmp}\n"), HasSubstr("board: missing required key"));
-  EXPECT_THAT(LoadError("board: {name: r1, profile: hardware}\nlog: {folder: /tmp}\n"),
+  EXPECT_THAT(LoadError("board: {name: r1, profile: real}\nlog: {folder: /tmp}\n"),
               AllOf(HasSubstr("board.profile"), HasSubstr("sim"), HasSubstr("replay"),
-                    HasSubstr("hardware")));
+                    HasSubstr("hardware"), HasSubstr("real")));
   EXPECT_THAT(LoadError("board: {name: rover 1, profile: sim}\nlog: {folder: /tmp}\n"),
               AllOf(StartsWith("board.yaml:1: board.name: "), HasSubstr("found \"rover 1\"")));
 }
@@ -261,6 +261,73 @@ TEST(BoardConfigTest, ReplaySectionGoesWithTheReplayProfile) {
   EXPECT_THAT(
       LoadError("board: {name: r1, profile: replay}\nreplay: {dataset: ''}\nlog: {folder: /t}\n"),
       HasSubstr("replay.dataset: expected the folder of a EuRoC-layout dataset"));
+}
+
+constexpr char kHardware[] =
+    "board: {name: r1, profile: hardware}\n"
+    "log: {folder: /tmp}\n"
+    "hardware:\n"
+    "  calibration: /etc/rover/calibration\n"
+    "  imu: {driver: xsens, device: /dev/ttyUSB0, rate_hz: 400, baud_rate: 921600}\n"
+    "  camera:\n"
+    "    driver: aravis\n"
+    "    cam0: 192.168.10.11\n"
+    "    cam1: 192.168.10.12\n"
+    "    width_px: 1024\n"
+    "    height_px: 508\n"
+    "    rate_hz: 15\n"
+    "    trigger: {chip: gpiochip2, line: 5}\n"
+    "  can: {interface: can1}\n";
+
+TEST(BoardConfigTest, HardwareSectionNamesTheDevices) {
+  const BoardConfig c = LoadYaml(kHardware);
+  EXPECT_EQ(c.board.profile, BoardProfile::kHardware);
+  ASSERT_TRUE(c.hardware.has_value());
+  EXPECT_FALSE(c.replay.has_value());
+  const BoardHardwareOptions& h = *c.hardware;
+  EXPECT_EQ(h.calibration, "/etc/rover/calibration");
+  EXPECT_EQ(h.imu.driver, ImuDriverKind::kXsens);
+  EXPECT_EQ(h.imu.device, "/dev/ttyUSB0");
+  EXPECT_EQ(h.imu.baud_rate, 921600);
+  ASSERT_TRUE(h.camera.has_value());
+  EXPECT_EQ(h.camera->driver, CameraDriverKind::kAravis);
+  EXPECT_EQ(h.camera->pixel_format, "Mono8");  // Aravis's default format
+  EXPECT_EQ(h.camera->width_px, 1024);
+  EXPECT_EQ(h.camera->rate_hz, 15.0);
+  ASSERT_TRUE(h.camera->trigger.has_value());
+  EXPECT_EQ(h.camera->trigger->chip, "gpiochip2");
+  EXPECT_EQ(h.camera->trigger->line, 5);
+  EXPECT_EQ(h.camera->trigger->pulse_width_s, 0.001);
+  ASSERT_TRUE(h.can.has_value());
+  EXPECT_EQ(h.can->interface, "can1");
+  EXPECT_NO_THROW(c.Validate());
+}
+
+TEST(BoardConfigTest, HardwareSectionGoesWithTheHardwareProfileAndIsChecked) {
+  EXPECT_THAT(LoadError("board: {name: r1, profile: hardware}\nlog: {folder: /tmp}\n"),
+              HasSubstr("hardware: expected a hardware section"));
+  EXPECT_THAT(LoadError(std::string(kMinimal) +
+                        "hardware: {calibration: /c, imu: {driver: xsens, device: /dev/ttyS1}}\n"),
+              HasSubstr("expected no hardware section with board.profile sim"));
+  auto with = [](const std::string& from, const std::string& to) {
+    std::string yaml = kHardware;
+    const std::size_t at = yaml.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return yaml.replace(at, from.size(), to);
+  };
+  EXPECT_THAT(LoadError(with("driver: xsens", "driver: mpu6050")),
+              AllOf(HasSubstr("hardware.imu.driver"), HasSubstr("adis16448")));
+  EXPECT_THAT(LoadError(with("cam1: 192.168.10.12", "cam1: 192.168.10.11")),
+              AllOf(HasSubstr("hardware.camera.cam0"), HasSubstr("two different cameras")));
+  EXPECT_THAT(LoadError(with("rate_hz: 15", "rate_hz: 500")),
+              AllOf(HasSubstr("hardware.camera.rate_hz"), HasSubstr("[1, 100]")));
+  EXPECT_THAT(LoadError(with("line: 5}", "line: 5, pulse_width_s: 0.5}")),
+              HasSubstr("hardware.camera.trigger.pulse_width_s"));
+  EXPECT_THAT(LoadError(with("interface: can1", "interface: ''")),
+              HasSubstr("hardware.can.interface"));
+  EXPECT_THAT(
+      LoadError(with("  can: {interface: can1}\n", "  can: {interface: can1, bitrate: 1}\n")),
+      HasSubstr("bitrate"));
 }
 
 TEST(BoardConfigTest, LogServiceIsValidatedAndServesTheLogFolder) {
