@@ -25,3 +25,22 @@ echo "== Stereo matching on EuRoC (bench_stereo_matcher)"
 echo
 echo "== Stereo VO per frame by stage on EuRoC (bench_stereo_odometry; pass a dataset dir for simulator data)"
 "$build/bench/vo/bench_stereo_odometry"
+echo
+echo "== Mapping: fast octree insertion vs insertPointCloud, SGBM at 752x480"
+"$build/bench/mapping/bench_octree_insertion"
+"$build/bench/mapping/bench_sgbm"
+echo
+echo "== Drivers: Xbus (Xsens MTi) decoding"
+"$build/bench/drivers/bench_xbus_decode"
+echo
+echo "== Drivers: Aravis streaming from arv-fake-gv-camera-0.8 on loopback"
+"$build/bench/drivers/bench_aravis_stream"
+# The V4L2 and SocketCAN figures need vivid and vcan: inside the HIL bench VM
+# (software emulation, so emulated-CPU figures).
+initramfs="$build/hil/bench/hil_bench_initramfs.cpio.gz"
+if [[ -f "$initramfs" ]]; then
+  echo
+  echo "== Drivers in the HIL bench VM: V4L2 from vivid, then SocketCAN on vcan0"
+  "$root/hil/bench/run_in_vm.sh" --initramfs "$initramfs" --out "$build/bench-vm" --timeout-s 600 \
+    -- sh -c "$build/bench/drivers/bench_v4l2_vivid && $build/bench/drivers/bench_can_decode"
+fi

@@ -15,6 +15,8 @@
 #include <cstring>
 #include <numeric>
 
+#include "core/time/posix_time.h"
+
 namespace rover::drivers {
 
 static_assert(V4l2Camera::kMaxBuffers == VIDEO_MAX_FRAME);
@@ -39,19 +41,6 @@ int Ioctl(int fd, unsigned long request, void* arg) {
     result = ioctl(fd, request, arg);
   } while (result != 0 && errno == EINTR);
   return result;
-}
-
-timespec ToTimespec(Duration d) {
-  const int64_t ns = std::max<int64_t>(0, d.nanoseconds());
-  return timespec{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
-}
-
-/// Sleeps until `wake` on CLOCK_MONOTONIC (no-op if it has passed).
-void SleepUntil(Time wake) {
-  const int64_t ns = wake.nanoseconds();
-  const timespec ts{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
 }
 
 /// Writes the normalised form of `name` (see NormalizeControlName) into

@@ -14,6 +14,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "core/time/posix_time.h"
+
 namespace rover::drivers {
 namespace {
 
@@ -25,11 +27,6 @@ int64_t ClockNs(clockid_t clock) {
   timespec ts{};
   clock_gettime(clock, &ts);
   return int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
-
-timespec ToTimespec(Duration d) {
-  const int64_t ns = std::max<int64_t>(0, d.nanoseconds());
-  return timespec{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
 }
 
 bool InterfaceGone(int error) { return error == ENETDOWN || error == ENODEV || error == ENXIO; }
@@ -176,12 +173,7 @@ void SocketCanBus::MarkDown() {
 }
 
 bool SocketCanBus::WaitAndReopen(Time deadline) {
-  const Time wake = std::min(deadline, next_reopen_);
-  const Duration wait = wake - Time::Now();
-  if (wait > Duration::Zero()) {
-    const timespec ts = ToTimespec(wait);
-    nanosleep(&ts, nullptr);
-  }
+  SleepUntil(std::min(deadline, next_reopen_));
   if (Time::Now() < next_reopen_) return false;
   const char* step = "";
   const int fd = OpenSocket(&step);

@@ -7,18 +7,10 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/time/posix_time.h"
+
 namespace rover::drivers {
 namespace {
-
-// Sleeps until `t` on CLOCK_MONOTONIC; returns at once if `t` has passed.
-// An absolute deadline keeps the grid exact however long the wake-up took.
-void SleepUntil(Time t) {
-  const int64_t ns = t.nanoseconds();
-  const timespec deadline{static_cast<time_t>(ns / 1'000'000'000),
-                          static_cast<long>(ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
-  }
-}
 
 std::string Number(double value) {
   char text[32];

@@ -9,6 +9,8 @@
 #include <cstring>
 #include <utility>
 
+#include "core/time/posix_time.h"
+
 namespace rover::drivers {
 
 struct LibgpiodChip::Impl {
@@ -102,11 +104,9 @@ class LibgpiodEventLine final : public GpioEventLine {
   LibgpiodEventLine& operator=(const LibgpiodEventLine&) = delete;
 
   ReadStatus Read(GpioEdge* edge, Duration timeout) override {
-    const int64_t ns = timeout.nanoseconds() > 0 ? timeout.nanoseconds() : 0;
     // ppoll rather than gpiod_line_event_wait: same syscall, but the fd is
     // cached, so nothing is looked up on the real-time path.
-    const timespec wait{static_cast<time_t>(ns / 1'000'000'000),
-                        static_cast<long>(ns % 1'000'000'000)};
+    const timespec wait = ToTimespec(timeout);
     pollfd p{fd_, POLLIN | POLLPRI, 0};
     const int ready = ppoll(&p, 1, &wait, nullptr);
     if (ready == 0) return ReadStatus::kTimeout;

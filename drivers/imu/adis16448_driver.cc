@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/time/posix_time.h"
 #include "drivers/imu/adis16448_registers.h"
 #include "drivers/imu/imu_device_error.h"
 
@@ -21,14 +22,6 @@ std::string Hex16(uint16_t value) {
   char text[8];
   std::snprintf(text, sizeof text, "0x%04X", value);
   return text;
-}
-
-void Sleep(Duration d) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(d.nanoseconds() / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(d.nanoseconds() % 1'000'000'000);
-  while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
-  }
 }
 
 }  // namespace
@@ -111,7 +104,7 @@ void Adis16448Driver::Frame(uint16_t word, uint16_t* answer, const char* step) {
                          ": SPI transfer failed: " + std::strerror(spi_.last_error()));
   }
   if (answer != nullptr) *answer = static_cast<uint16_t>((rx[0] << 8) | rx[1]);
-  Sleep(options_.register_stall);
+  SleepFor(options_.register_stall);
 }
 
 uint16_t Adis16448Driver::ReadRegister(uint8_t address) {

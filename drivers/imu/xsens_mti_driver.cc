@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/time/posix_time.h"
 #include "drivers/imu/imu_device_error.h"
 #include "drivers/imu/xbus_protocol.h"
 
@@ -33,13 +34,6 @@ std::string Hex(uint64_t value, int digits) {
   char text[24];
   std::snprintf(text, sizeof text, "0x%0*llX", digits, static_cast<unsigned long long>(value));
   return text;
-}
-
-timespec ToTimespec(Duration d) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(d.nanoseconds() / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(d.nanoseconds() % 1'000'000'000);
-  return ts;
 }
 
 SerialPortOptions PortOptions(const XsensMtiOptions& options) {
@@ -290,13 +284,7 @@ ReadStatus XsensMtiDriver::Read(ImuSample* sample, Duration timeout) {
       // with an error: without a wait the caller's loop would spin. One
       // error per timeout is enough to notice, and leaves the CPU to others.
       ++stats_.read_errors;
-      const Duration left = deadline - Time::Now();
-      if (left > Duration::Zero()) {
-        const int64_t ns = left.nanoseconds();
-        const timespec pause{static_cast<time_t>(ns / 1'000'000'000),
-                             static_cast<long>(ns % 1'000'000'000)};
-        clock_nanosleep(CLOCK_MONOTONIC, 0, &pause, nullptr);
-      }
+      SleepUntil(deadline);
       return ReadStatus::kError;
     }
     if (timed_out) {

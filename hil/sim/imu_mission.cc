@@ -13,6 +13,7 @@
 
 #include "core/log/flight/flight_log.h"
 #include "core/log/msgs/all_msgs.h"
+#include "core/time/posix_time.h"
 #include "hil/sim/world/world.h"
 
 namespace rover::sim {
@@ -28,14 +29,6 @@ bool TrySetFifoPriority(int priority) {
   sched_param param{};
   param.sched_priority = priority;
   return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
-}
-
-void SleepUntil(Time t) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t.nanoseconds() / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(t.nanoseconds() % 1'000'000'000);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
 }
 
 double Percentile(std::vector<double> v, double p) {

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/time/posix_time.h"
+
 namespace rover::runtime {
 namespace {
 
@@ -12,15 +14,7 @@ class MonotonicClockImpl final : public PeriodicTimer::Clock {
  public:
   Time Now() override { return Time::Now(); }
 
-  void SleepUntil(Time deadline) override {
-    timespec ts{};
-    ts.tv_sec = static_cast<time_t>(deadline.nanoseconds() / 1'000'000'000);
-    ts.tv_nsec = static_cast<long>(deadline.nanoseconds() % 1'000'000'000);
-    // clock_nanosleep returns the error number; with TIMER_ABSTIME a retry
-    // after a signal simply sleeps the rest of the way to the same deadline.
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-    }
-  }
+  void SleepUntil(Time deadline) override { rover::SleepUntil(deadline); }
 };
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/time/posix_time.h"
 #include "drivers/imu/xbus_protocol.h"
 #include "hil/sim/seed.h"
 
@@ -27,14 +28,6 @@ constexpr std::size_t kCounter = 0, kTime = 1, kAccel = 2, kGyro = 3;
 double HashNoise(uint64_t seed, uint64_t k, uint64_t axis) {
   const uint64_t h = StreamSeed(seed, k * 8 + axis);
   return static_cast<double>(h >> 11) * 0x1.0p-52 - 1.0;
-}
-
-void SleepUntil(Time t) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t.nanoseconds() / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(t.nanoseconds() % 1'000'000'000);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
 }
 
 std::runtime_error PtyError(const std::string& step) {
