@@ -1,5 +1,6 @@
 #include "firmware/roverd/hardware_board.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 
@@ -19,6 +20,13 @@ namespace rover::roverd {
 namespace {
 
 namespace fs = std::filesystem;
+
+// "400 Hz", "409.6 Hz": rates as a user wrote them.
+std::string Hz(double rate_hz) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g Hz", rate_hz);
+  return text;
+}
 
 std::string SensorYaml(const std::string& folder, const std::string& sensor) {
   const fs::path path = fs::path(folder) / sensor / "sensor.yaml";
@@ -42,6 +50,9 @@ std::unique_ptr<drivers::MonoCamera> OpenCamera(const runtime::BoardCameraOption
     if (!triggered) o.frame_rate_hz = c.rate_hz;
     o.buffer_count = c.buffers;
     if (c.exposure_us > 0.0) o.exposure = Duration::FromSeconds(c.exposure_us * 1e-6);
+    // Triggered V4L2 sensors expose a vendor "trigger mode" control, where 1
+    // is external trigger in the common convention; a camera without one
+    // fails start-up instead of free-running unnoticed.
     o.trigger_required = triggered;
     if (triggered) o.trigger_value = 1;
     return std::make_unique<drivers::V4l2Camera>(o);
@@ -102,12 +113,13 @@ void HardwareBoard::OpenImu(const runtime::BoardImuOptions& imu) {
     o.port = imu.device;
     o.baud_rate = imu.baud_rate;
     o.rate_hz = imu.rate_hz;
-    std::string device_id;
-    o.log = [&device_id](const std::string& line) { device_id = line; };
-    imu_ = std::make_unique<drivers::XsensMtiDriver>(o);
-    description_ += "  imu     Xsens MTi on " + imu.device + " at " +
-                    std::to_string(imu.baud_rate) + " baud, " + std::to_string(imu.rate_hz) +
-                    " Hz (" + device_id + ")\n";
+    o.log = [](const std::string&) {};  // the id goes into the description below
+    auto xsens = std::make_unique<drivers::XsensMtiDriver>(o);
+    char id[16];
+    std::snprintf(id, sizeof id, "0x%08X", static_cast<unsigned>(xsens->device_id()));
+    description_ += "  imu     Xsens MTi " + std::string(id) + " on " + imu.device + " at " +
+                    std::to_string(imu.baud_rate) + " baud, " + Hz(imu.rate_hz) + "\n";
+    imu_ = std::move(xsens);
     return;
   }
   data_ready_chip_ = std::make_unique<drivers::LibgpiodChip>(imu.data_ready_chip);
@@ -124,8 +136,7 @@ void HardwareBoard::OpenImu(const runtime::BoardImuOptions& imu) {
   o.rate_hz = imu.rate_hz;
   imu_ = std::make_unique<drivers::Adis16448Driver>(*spi_, *data_ready_, o);
   description_ += "  imu     ADIS16448 on " + imu.device + ", data ready " + imu.data_ready_chip +
-                  " line " + std::to_string(imu.data_ready_line) + ", " +
-                  std::to_string(imu.rate_hz) + " Hz\n";
+                  " line " + std::to_string(imu.data_ready_line) + ", " + Hz(imu.rate_hz) + "\n";
 }
 
 void HardwareBoard::OpenCameras(const runtime::BoardCameraOptions& camera) {
@@ -147,8 +158,7 @@ void HardwareBoard::OpenCameras(const runtime::BoardCameraOptions& camera) {
     t.active_low = camera.trigger->active_low;
     trigger_ = std::make_unique<drivers::GpioCameraTrigger>(*trigger_chip_, t);
     description_ += "  trigger " + camera.trigger->chip + " line " +
-                    std::to_string(camera.trigger->line) + " at " + std::to_string(camera.rate_hz) +
-                    " Hz\n";
+                    std::to_string(camera.trigger->line) + " at " + Hz(camera.rate_hz) + "\n";
   }
 }
 
