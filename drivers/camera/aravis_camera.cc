@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "core/time/realtime_to_monotonic.h"
 #include "drivers/camera/device_clock_fit.h"
 
 namespace rover::drivers {
@@ -135,12 +136,6 @@ struct SequenceExtender {
     continuation = continued;
   }
 };
-
-int64_t ReadRealtimeNs() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 }  // namespace
 
@@ -311,6 +306,7 @@ struct AravisCamera::Impl {
   bool have_delivered = false;
   uint64_t last_delivered = 0;
   DeviceClockFit fit;
+  RealtimeToMonotonic to_monotonic;  // Aravis's buffer system stamps are realtime
 
   AtomicStats stats;
 };
@@ -785,15 +781,13 @@ bool AravisCamera::Impl::FillFrame(ArvBuffer* buffer, Slot* slot, Time popped, C
   last_delivered = seq;
 
   // Host receive time: Aravis stamps the buffer on CLOCK_REALTIME when its
-  // packets arrive, closer to the wire than our pop. Moved onto
-  // CLOCK_MONOTONIC through a fresh realtime/monotonic pair; a step of the
-  // realtime clock then looks like latency (or a reset) to the fit.
+  // packets arrive, closer to the wire than our pop; moved onto
+  // CLOCK_MONOTONIC (a step of the realtime clock then looks like latency,
+  // or a reset, to the fit).
   Time host_receive = popped;
   const auto system_ns = static_cast<int64_t>(arv_buffer_get_system_timestamp(buffer));
   if (system_ns > 0) {
-    const Time mono = Time::Now();
-    const int64_t real_ns = ReadRealtimeNs();
-    const Time candidate = mono - Duration::Nanoseconds(real_ns - system_ns);
+    const Time candidate = to_monotonic.ToMonotonic(system_ns);
     if (candidate <= popped && candidate > popped - Duration::Seconds(1)) host_receive = candidate;
   }
   const auto device_ns = static_cast<int64_t>(arv_buffer_get_timestamp(buffer));

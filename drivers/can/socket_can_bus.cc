@@ -23,12 +23,6 @@ void Add(std::atomic<uint64_t>& counter, uint64_t n = 1) {
   counter.fetch_add(n, std::memory_order_relaxed);
 }
 
-int64_t ClockNs(clockid_t clock) {
-  timespec ts{};
-  clock_gettime(clock, &ts);
-  return int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
-
 bool InterfaceGone(int error) { return error == ENETDOWN || error == ENODEV || error == ENXIO; }
 
 }  // namespace
@@ -250,17 +244,15 @@ ReadStatus SocketCanBus::ReceiveOne(CanFrame* frame, bool* data_frame) {
     }
     return ReadStatus::kError;
   }
-  // The kernel stamps frames on CLOCK_REALTIME; the realtime - monotonic
-  // offset moves the stamp onto CLOCK_MONOTONIC.
-  RefreshClockOffset();
-  int64_t stamp_ns = ClockNs(CLOCK_MONOTONIC);
-  const int64_t real_minus_mono = real_minus_mono_ns_;
+  // The kernel stamps frames on CLOCK_REALTIME (SO_TIMESTAMPNS).
+  int64_t stamp_ns = Time::Now().nanoseconds();
   for (cmsghdr* c = CMSG_FIRSTHDR(&message); c != nullptr; c = CMSG_NXTHDR(&message, c)) {
     if (c->cmsg_level != SOL_SOCKET) continue;
     if (c->cmsg_type == SO_TIMESTAMPNS) {
       timespec ts{};
       std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
-      stamp_ns = int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec - real_minus_mono;
+      stamp_ns =
+          to_monotonic_.ToMonotonic(int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec).nanoseconds();
     } else if (c->cmsg_type == SO_RXQ_OVFL) {
       uint32_t drops = 0;
       std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
@@ -295,29 +287,6 @@ ReadStatus SocketCanBus::ReceiveOne(CanFrame* frame, bool* data_frame) {
   Add(frames_);
   *data_frame = true;
   return ReadStatus::kOk;
-}
-
-void SocketCanBus::RefreshClockOffset() {
-  // Read monotonic, realtime, monotonic: the offset is only as good as the
-  // bracket is tight. A thread preempted between the reads (any guest under
-  // emulation, any busy board) would otherwise shift stamps by milliseconds,
-  // so a wide bracket keeps the previous offset. The offset itself changes
-  // only when the realtime clock is stepped or slewed.
-  constexpr int64_t kTightBracketNs = 50'000;
-  constexpr int64_t kRefreshPeriodNs = 100'000'000;
-  const int64_t mono_before = ClockNs(CLOCK_MONOTONIC);
-  if (offset_valid_ && mono_before - offset_read_at_ns_ < kRefreshPeriodNs) return;
-  for (int attempt = 0; attempt < (offset_valid_ ? 1 : 20); ++attempt) {
-    const int64_t m1 = attempt == 0 ? mono_before : ClockNs(CLOCK_MONOTONIC);
-    const int64_t real = ClockNs(CLOCK_REALTIME);
-    const int64_t m2 = ClockNs(CLOCK_MONOTONIC);
-    if (m2 - m1 <= kTightBracketNs || (!offset_valid_ && attempt == 19)) {
-      real_minus_mono_ns_ = real - (m1 + (m2 - m1) / 2);
-      offset_read_at_ns_ = m2;
-      offset_valid_ = true;
-      return;
-    }
-  }
 }
 
 void SocketCanBus::HandleErrorFrame(uint32_t can_id, const uint8_t* data) {

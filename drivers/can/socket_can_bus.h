@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "core/time/realtime_to_monotonic.h"
 #include "drivers/can/can_bus.h"
 
 namespace rover::drivers {
@@ -130,8 +131,6 @@ class SocketCanBus final : public CanBus {
   /// Receives one frame from the open socket; kTimeout if none is queued.
   ReadStatus ReceiveOne(CanFrame* frame, bool* data_frame);
   void HandleErrorFrame(uint32_t can_id, const uint8_t* data);
-  /// Re-reads the realtime - monotonic offset every 100 ms (see .cc).
-  void RefreshClockOffset();
 
   SocketCanOptions options_;
   std::vector<unsigned char> kernel_filters_;  ///< struct can_filter[], built once
@@ -139,9 +138,7 @@ class SocketCanBus final : public CanBus {
   Time next_reopen_;
   Duration backoff_;
   uint32_t last_drop_count_ = 0;
-  int64_t real_minus_mono_ns_ = 0;
-  int64_t offset_read_at_ns_ = 0;
-  bool offset_valid_ = false;
+  RealtimeToMonotonic to_monotonic_;  ///< the kernel's receive stamps are realtime
   int64_t last_stamp_ns_ = 0;
   std::atomic<CanBusHealth> health_{CanBusHealth::kActive};
   std::atomic<uint64_t> frames_{0}, error_frames_{0}, bus_off_{0}, restarts_{0},
