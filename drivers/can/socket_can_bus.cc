@@ -144,7 +144,11 @@ int SocketCanBus::OpenSocket(const char** step) const {
   if (setsockopt(fd, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on) != 0) {
     return fail("cannot enable the drop counter (SO_RXQ_OVFL)");
   }
+  // SO_RCVBUF alone is capped at rmem_max without a word; FORCE is not,
+  // but needs CAP_NET_ADMIN, which a board's roverd usually has.
   if (options_.receive_buffer_bytes > 0 &&
+      setsockopt(fd, SOL_SOCKET, SO_RCVBUFFORCE, &options_.receive_buffer_bytes,
+                 sizeof options_.receive_buffer_bytes) != 0 &&
       setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &options_.receive_buffer_bytes,
                  sizeof options_.receive_buffer_bytes) != 0) {
     return fail("cannot set the receive buffer size (SO_RCVBUF)");
@@ -156,6 +160,14 @@ int SocketCanBus::OpenSocket(const char** step) const {
     return fail("cannot bind");
   }
   return fd;
+}
+
+int SocketCanBus::receive_buffer_bytes() const {
+  if (fd_ < 0) return 0;
+  int bytes = 0;
+  socklen_t length = sizeof bytes;
+  if (getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &bytes, &length) != 0) return 0;
+  return bytes;
 }
 
 void SocketCanBus::MarkDown() {

@@ -49,7 +49,11 @@ struct SocketCanOptions {
   std::vector<CanFilter> filters;
   /// Receive the controller's error frames (bus-off, error passive, ...).
   bool error_frames = true;
-  /// SO_RCVBUF in bytes (the kernel doubles it); 0 keeps the system default.
+  /// Socket receive buffer in bytes (the kernel doubles it for its own
+  /// bookkeeping); 0 keeps the system default. Set with SO_RCVBUFFORCE when
+  /// the process may (CAP_NET_ADMIN), else with SO_RCVBUF, which the kernel
+  /// silently caps at net.core.rmem_max (about 208 KiB by default, some 250
+  /// CAN frames); check receive_buffer_bytes() on the open bus.
   int receive_buffer_bytes = 0;
   /// Backoff between attempts to reopen an interface that went away: starts
   /// at `reopen_backoff_initial`, doubles up to `reopen_backoff_max`.
@@ -119,6 +123,10 @@ class SocketCanBus final : public CanBus {
   /// A consistent-enough copy of the counters; any thread.
   SocketCanStats stats() const;
   const std::string& interface() const { return options_.interface; }
+  /// The receive buffer the kernel actually granted (SO_RCVBUF read back,
+  /// doubled as the kernel reports it); 0 while the interface is down.
+  /// A system call: for start-up checks and diagnostics, owner thread only.
+  int receive_buffer_bytes() const;
 
  private:
   /// Opens, configures and binds the socket; returns the fd, or -1 with

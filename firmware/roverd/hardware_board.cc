@@ -101,7 +101,8 @@ HardwareBoard::HardwareBoard(const runtime::BoardHardwareOptions& options) {
     can.interface = options.can->interface;
     can.filters = drivers::SocketCanOptions::WheelDriveFilters();
     can_ = std::make_unique<drivers::SocketCanBus>(can);
-    description_ += "  can     " + can.interface + " (SocketCAN, wheel-drive filters)\n";
+    description_ += "  can     " + can.interface + " (SocketCAN, wheel-drive filters, " +
+                    std::to_string(can_->receive_buffer_bytes() / 1024) + " KiB receive buffer)\n";
   }
 }
 
