@@ -40,7 +40,7 @@ echo "== Drivers: Aravis streaming from arv-fake-gv-camera-0.8 on loopback"
 initramfs="$build/hil/bench/hil_bench_initramfs.cpio.gz"
 if [[ -f "$initramfs" ]]; then
   echo
-  echo "== Drivers in the HIL bench VM: V4L2 from vivid, then SocketCAN on vcan0"
+  echo "== Drivers in the HIL bench VM: V4L2 from vivid (single-, then multi-planar), then SocketCAN on vcan0"
   "$root/hil/bench/run_in_vm.sh" --initramfs "$initramfs" --out "$build/bench-vm" --timeout-s 600 \
-    -- sh -c "$build/bench/drivers/bench_v4l2_vivid && $build/bench/drivers/bench_can_decode"
+    -- sh -c "$build/bench/drivers/bench_v4l2_vivid && $build/bench/drivers/bench_v4l2_vivid --device /dev/video1 && $build/bench/drivers/bench_can_decode"
 fi

@@ -23,12 +23,86 @@ static_assert(V4l2Camera::kMaxBuffers == VIDEO_MAX_FRAME);
 
 namespace {
 
-constexpr uint32_t kCaptureType = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+constexpr uint32_t kSinglePlanar = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+constexpr uint32_t kMultiPlanar = V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE;
 /// Buffer indices handed out are generation * kMaxBuffers + index; the
 /// generation wraps here so the index stays a positive int.
 constexpr uint32_t kGenerationMask = (1u << 20) - 1;
 /// Relative tolerance of a negotiated frame rate.
 constexpr double kFrameRateTolerance = 1e-3;
+
+uint32_t CaptureType(bool multi_planar) { return multi_planar ? kMultiPlanar : kSinglePlanar; }
+
+/// A v4l2_buffer for either capture API. The multi-planar API (the one most
+/// SoC capture interfaces speak) describes every memory plane in its own
+/// v4l2_plane; the camera takes single-plane formats only, so one is enough.
+struct BufferRequest {
+  v4l2_buffer buffer{};
+  v4l2_plane plane{};
+
+  BufferRequest(bool multi_planar, uint32_t index) {
+    buffer.type = CaptureType(multi_planar);
+    buffer.memory = V4L2_MEMORY_MMAP;
+    buffer.index = index;
+    if (multi_planar) {
+      buffer.m.planes = &plane;
+      buffer.length = 1;
+    }
+  }
+  BufferRequest(const BufferRequest&) = delete;  // buffer points at plane
+  BufferRequest& operator=(const BufferRequest&) = delete;
+
+  bool multi_planar() const { return buffer.type == kMultiPlanar; }
+  /// Bytes of the mapping.
+  uint32_t length() const { return multi_planar() ? plane.length : buffer.length; }
+  /// The mmap offset of the buffer.
+  off_t map_offset() const {
+    return static_cast<off_t>(multi_planar() ? plane.m.mem_offset : buffer.m.offset);
+  }
+  /// Where the image starts in the mapping, and its bytes: a multi-planar
+  /// driver may put a header first (data_offset, included in bytesused).
+  uint32_t data_offset() const { return multi_planar() ? plane.data_offset : 0u; }
+  uint32_t bytes_used() const { return multi_planar() ? plane.bytesused : buffer.bytesused; }
+};
+
+/// A format request for the API in use: one plane, progressive.
+v4l2_format FormatRequest(bool multi_planar, uint32_t fourcc, uint32_t width, uint32_t height) {
+  v4l2_format format{};
+  format.type = CaptureType(multi_planar);
+  if (multi_planar) {
+    format.fmt.pix_mp.width = width;
+    format.fmt.pix_mp.height = height;
+    format.fmt.pix_mp.pixelformat = fourcc;
+    format.fmt.pix_mp.field = V4L2_FIELD_NONE;
+    format.fmt.pix_mp.num_planes = 1;
+  } else {
+    format.fmt.pix.width = width;
+    format.fmt.pix.height = height;
+    format.fmt.pix.pixelformat = fourcc;
+    format.fmt.pix.field = V4L2_FIELD_NONE;
+  }
+  return format;
+}
+
+/// A format of either API as the single-planar struct (plane 0's stride
+/// and size), so negotiation and its messages need one form only.
+v4l2_pix_format SinglePlaneView(const v4l2_format& format) {
+  if (format.type != kMultiPlanar) return format.fmt.pix;
+  const v4l2_pix_format_mplane& mp = format.fmt.pix_mp;
+  v4l2_pix_format view{};
+  view.width = mp.width;
+  view.height = mp.height;
+  view.pixelformat = mp.pixelformat;
+  view.field = mp.field;
+  view.bytesperline = mp.plane_fmt[0].bytesperline;
+  view.sizeimage = mp.plane_fmt[0].sizeimage;
+  view.colorspace = mp.colorspace;
+  return view;
+}
+
+uint32_t PlaneCount(const v4l2_format& format) {
+  return format.type == kMultiPlanar ? format.fmt.pix_mp.num_planes : 1u;
+}
 
 void Add(std::atomic<uint64_t>& counter, uint64_t n = 1) {
   counter.fetch_add(n, std::memory_order_relaxed);
@@ -220,12 +294,12 @@ std::string ListSizes(int fd, uint32_t fourcc) {
 
 /// "YUYV 320x180 640x480; GREY 640x480; ..." (VIDIOC_ENUM_FMT and
 /// VIDIOC_ENUM_FRAMESIZES).
-std::string ListFormats(int fd) {
+std::string ListFormats(int fd, bool multi_planar) {
   std::string text;
   for (uint32_t i = 0; i < 256; ++i) {
     v4l2_fmtdesc d{};
     d.index = i;
-    d.type = kCaptureType;
+    d.type = CaptureType(multi_planar);
     if (Ioctl(fd, VIDIOC_ENUM_FMT, &d) != 0) break;
     if (!text.empty()) text += "; ";
     text += FourccToString(d.pixelformat) + " " + ListSizes(fd, d.pixelformat);
@@ -297,6 +371,7 @@ struct V4l2Camera::StartFailure {
   const char* call = "";        ///< the ioctl or call that failed
   uint32_t capabilities = 0;    ///< what QUERYCAP reported
   v4l2_pix_format got{};        ///< the format the driver proposed or set
+  uint32_t got_planes = 1;      ///< its memory planes (multi-planar API)
   v4l2_fract got_interval{};    ///< the frame interval the driver set
   const char* control = "";     ///< the option behind the control
   const char* control_id = "";  ///< the V4L2 control it needs
@@ -386,11 +461,15 @@ bool V4l2Camera::OpenAndStart(StartFailure* failure) {
   }
   const uint32_t caps =
       (cap.capabilities & V4L2_CAP_DEVICE_CAPS) != 0 ? cap.device_caps : cap.capabilities;
-  if ((caps & V4L2_CAP_VIDEO_CAPTURE) == 0 || (caps & V4L2_CAP_STREAMING) == 0) {
+  // The single-planar API where the device has it; otherwise the
+  // multi-planar one, which many SoC (CSI-2) capture drivers offer alone.
+  const bool capture = (caps & (V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_VIDEO_CAPTURE_MPLANE)) != 0;
+  if (!capture || (caps & V4L2_CAP_STREAMING) == 0) {
     failure->step = StartFailure::Step::kCapabilities;
     failure->capabilities = caps;
     return false;
   }
+  multi_planar_ = (caps & V4L2_CAP_VIDEO_CAPTURE) == 0;
   if (options_.input.has_value()) {
     int input = *options_.input;
     if (Ioctl(fd_, VIDIOC_S_INPUT, &input) != 0) {
@@ -407,25 +486,25 @@ bool V4l2Camera::OpenAndStart(StartFailure* failure) {
 }
 
 bool V4l2Camera::Negotiate(StartFailure* failure) {
-  v4l2_format format{};
-  format.type = kCaptureType;
-  format.fmt.pix.width = static_cast<uint32_t>(options_.width_px);
-  format.fmt.pix.height = static_cast<uint32_t>(options_.height_px);
-  format.fmt.pix.pixelformat = fourcc_;
-  format.fmt.pix.field = V4L2_FIELD_NONE;
+  const uint32_t width = static_cast<uint32_t>(options_.width_px);
+  const uint32_t height = static_cast<uint32_t>(options_.height_px);
+  v4l2_format format = FormatRequest(multi_planar_, fourcc_, width, height);
   auto exact = [&](const v4l2_format& f) {
-    return f.fmt.pix.pixelformat == fourcc_ && f.fmt.pix.width == format.fmt.pix.width &&
-           f.fmt.pix.height == format.fmt.pix.height && f.fmt.pix.field == V4L2_FIELD_NONE;
+    const v4l2_pix_format got = SinglePlaneView(f);
+    return got.pixelformat == fourcc_ && got.width == width && got.height == height &&
+           got.field == V4L2_FIELD_NONE && PlaneCount(f) == 1;
+  };
+  auto mismatch = [&](const v4l2_format& f) {
+    failure->step = StartFailure::Step::kFormatMismatch;
+    failure->got = SinglePlaneView(f);
+    failure->got_planes = PlaneCount(f);
+    return false;
   };
   // TRY_FMT first: a refused request then leaves the device as it was.
   // It is optional for drivers (ENOTTY): S_FMT's answer is checked anyway.
   v4l2_format trial = format;
   if (Ioctl(fd_, VIDIOC_TRY_FMT, &trial) == 0) {
-    if (!exact(trial)) {
-      failure->step = StartFailure::Step::kFormatMismatch;
-      failure->got = trial.fmt.pix;
-      return false;
-    }
+    if (!exact(trial)) return mismatch(trial);
   } else if (errno != ENOTTY) {
     failure->step = StartFailure::Step::kFormat;
     failure->error = errno;
@@ -438,13 +517,10 @@ bool V4l2Camera::Negotiate(StartFailure* failure) {
     failure->call = "VIDIOC_S_FMT";
     return false;
   }
-  if (!exact(format)) {
-    failure->step = StartFailure::Step::kFormatMismatch;
-    failure->got = format.fmt.pix;
-    return false;
-  }
+  if (!exact(format)) return mismatch(format);
+  const v4l2_pix_format set = SinglePlaneView(format);
   // Some drivers leave bytesperline at 0 for packed formats: a tight row.
-  std::size_t bytes_per_line = format.fmt.pix.bytesperline;
+  std::size_t bytes_per_line = set.bytesperline;
   if (bytes_per_line == 0 && fourcc_ != V4L2_PIX_FMT_MJPEG) {
     bytes_per_line =
         static_cast<std::size_t>(options_.width_px) * (fourcc_ == V4L2_PIX_FMT_GREY ? 1u : 2u);
@@ -452,14 +528,14 @@ bool V4l2Camera::Negotiate(StartFailure* failure) {
   // After a reconnect the preallocated conversion must still fit.
   if (bytes_per_line_ != 0 && bytes_per_line != bytes_per_line_) {
     failure->step = StartFailure::Step::kStrideChanged;
-    failure->got = format.fmt.pix;
+    failure->got = set;
     return false;
   }
   bytes_per_line_ = bytes_per_line;
-  size_image_ = format.fmt.pix.sizeimage;
+  size_image_ = set.sizeimage;
 
   v4l2_streamparm parm{};
-  parm.type = kCaptureType;
+  parm.type = CaptureType(multi_planar_);
   const bool has_parm = Ioctl(fd_, VIDIOC_G_PARM, &parm) == 0;
   const bool settable = has_parm && (parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME) != 0;
   if (options_.frame_rate_hz.has_value()) {
@@ -470,7 +546,7 @@ bool V4l2Camera::Negotiate(StartFailure* failure) {
       return false;
     }
     parm = v4l2_streamparm{};
-    parm.type = kCaptureType;
+    parm.type = CaptureType(multi_planar_);
     parm.parm.capture.timeperframe = IntervalOf(*options_.frame_rate_hz);
     if (Ioctl(fd_, VIDIOC_S_PARM, &parm) != 0) {
       failure->step = StartFailure::Step::kFrameInterval;
@@ -573,7 +649,7 @@ bool V4l2Camera::ApplyControls(StartFailure* failure) {
 bool V4l2Camera::StartBuffers(StartFailure* failure) {
   v4l2_requestbuffers request{};
   request.count = static_cast<uint32_t>(options_.buffer_count);
-  request.type = kCaptureType;
+  request.type = CaptureType(multi_planar_);
   request.memory = V4L2_MEMORY_MMAP;
   if (Ioctl(fd_, VIDIOC_REQBUFS, &request) != 0) {
     failure->step = StartFailure::Step::kBuffers;
@@ -591,19 +667,16 @@ bool V4l2Camera::StartBuffers(StartFailure* failure) {
   }
   for (uint32_t i = 0; i < request.count; ++i) {
     Buffer& b = buffers_[i];
-    v4l2_buffer query{};
-    query.type = kCaptureType;
-    query.memory = V4L2_MEMORY_MMAP;
-    query.index = i;
+    BufferRequest query(multi_planar_, i);
     failure->buffers = i;
-    if (Ioctl(fd_, VIDIOC_QUERYBUF, &query) != 0) {
+    if (Ioctl(fd_, VIDIOC_QUERYBUF, &query.buffer) != 0) {
       failure->step = StartFailure::Step::kMap;
       failure->error = errno;
       failure->call = "VIDIOC_QUERYBUF";
       return false;
     }
     // Capture buffers are only read: PROT_READ is all vb2 asks for.
-    void* start = mmap(nullptr, query.length, PROT_READ, MAP_SHARED, fd_, query.m.offset);
+    void* start = mmap(nullptr, query.length(), PROT_READ, MAP_SHARED, fd_, query.map_offset());
     if (start == MAP_FAILED) {
       failure->step = StartFailure::Step::kMap;
       failure->error = errno;
@@ -611,13 +684,14 @@ bool V4l2Camera::StartBuffers(StartFailure* failure) {
       return false;
     }
     b.start = start;
-    b.length = query.length;
+    b.length = query.length();
     b.mapped = true;
     b.held = false;
     if (options_.export_dmabuf) {
       v4l2_exportbuffer e{};
-      e.type = kCaptureType;
+      e.type = CaptureType(multi_planar_);
       e.index = i;
+      e.plane = 0;
       e.flags = O_RDONLY | O_CLOEXEC;
       if (Ioctl(fd_, VIDIOC_EXPBUF, &e) != 0) {
         failure->step = StartFailure::Step::kExport;
@@ -630,11 +704,8 @@ bool V4l2Camera::StartBuffers(StartFailure* failure) {
   }
   buffer_count_ = static_cast<int>(request.count);
   for (uint32_t i = 0; i < request.count; ++i) {
-    v4l2_buffer buffer{};
-    buffer.type = kCaptureType;
-    buffer.memory = V4L2_MEMORY_MMAP;
-    buffer.index = i;
-    if (Ioctl(fd_, VIDIOC_QBUF, &buffer) != 0) {
+    BufferRequest buffer(multi_planar_, i);
+    if (Ioctl(fd_, VIDIOC_QBUF, &buffer.buffer) != 0) {
       failure->step = StartFailure::Step::kQueue;
       failure->error = errno;
       failure->call = "VIDIOC_QBUF";
@@ -642,7 +713,7 @@ bool V4l2Camera::StartBuffers(StartFailure* failure) {
       return false;
     }
   }
-  int type = kCaptureType;
+  int type = static_cast<int>(CaptureType(multi_planar_));
   if (Ioctl(fd_, VIDIOC_STREAMON, &type) != 0) {
     failure->step = StartFailure::Step::kStreamOn;
     failure->error = errno;
@@ -654,7 +725,7 @@ bool V4l2Camera::StartBuffers(StartFailure* failure) {
 
 void V4l2Camera::StopAndClose() {
   if (fd_ >= 0) {
-    int type = kCaptureType;
+    int type = static_cast<int>(CaptureType(multi_planar_));
     Ioctl(fd_, VIDIOC_STREAMOFF, &type);
   }
   for (Buffer& b : buffers_) {
@@ -703,8 +774,9 @@ std::string V4l2Camera::Describe(const StartFailure& f) const {
       return prefix + "not a V4L2 device: expected VIDIOC_QUERYCAP to succeed, it failed with " +
              ErrnoText(f.error);
     case Step::kCapabilities:
-      return prefix + "expected a single-planar video capture device with streaming I/O " +
-             "(V4L2_CAP_VIDEO_CAPTURE and V4L2_CAP_STREAMING), found: " +
+      return prefix + "expected a video capture device with streaming I/O " +
+             "(V4L2_CAP_VIDEO_CAPTURE or V4L2_CAP_VIDEO_CAPTURE_MPLANE, and "
+             "V4L2_CAP_STREAMING), found: " +
              CapabilityNames(f.capabilities);
     case Step::kInput: {
       std::string inputs;
@@ -721,14 +793,18 @@ std::string V4l2Camera::Describe(const StartFailure& f) const {
     }
     case Step::kFormat:
       return prefix + "format " + asked + " refused (" + f.call + ": " + ErrnoText(f.error) +
-             "); the device offers: " + (fd >= 0 ? ListFormats(fd) : "(cannot list)");
+             "); the device offers: " +
+             (fd >= 0 ? ListFormats(fd, multi_planar_) : "(cannot list)");
     case Step::kFormatMismatch:
       return prefix + "format " + asked + " progressive is not available: the driver proposed " +
              FourccToString(f.got.pixelformat) + " " + SizeText(f.got.width, f.got.height) +
              (f.got.field == V4L2_FIELD_NONE
                   ? ""
                   : " (field " + std::to_string(f.got.field) + ", not progressive)") +
-             "; the device offers: " + (fd >= 0 ? ListFormats(fd) : "(cannot list)");
+             (f.got_planes == 1 ? ""
+                                : " in " + std::to_string(f.got_planes) +
+                                      " memory planes (expected one: single-plane formats only)") +
+             "; the device offers: " + (fd >= 0 ? ListFormats(fd, multi_planar_) : "(cannot list)");
     case Step::kStrideChanged:
       return prefix + "after reopening, " + asked + " has " + std::to_string(f.got.bytesperline) +
              " bytes per line instead of " + std::to_string(bytes_per_line_);
@@ -818,20 +894,16 @@ bool V4l2Camera::WaitAndReconnect(Time deadline) {
 }
 
 bool V4l2Camera::Queue(uint32_t index) {
-  v4l2_buffer buffer{};
-  buffer.type = kCaptureType;
-  buffer.memory = V4L2_MEMORY_MMAP;
-  buffer.index = index;
-  if (Ioctl(fd_, VIDIOC_QBUF, &buffer) == 0) return true;
+  BufferRequest request(multi_planar_, index);
+  if (Ioctl(fd_, VIDIOC_QBUF, &request.buffer) == 0) return true;
   MarkDisconnected(errno);
   return false;
 }
 
 V4l2Camera::Dequeued V4l2Camera::DequeueOne(CameraFrame* frame, bool poll_error) {
-  v4l2_buffer buffer{};
-  buffer.type = kCaptureType;
-  buffer.memory = V4L2_MEMORY_MMAP;
-  if (Ioctl(fd_, VIDIOC_DQBUF, &buffer) != 0) {
+  BufferRequest request(multi_planar_, 0);
+  const v4l2_buffer& buffer = request.buffer;
+  if (Ioctl(fd_, VIDIOC_DQBUF, &request.buffer) != 0) {
     if (errno != EAGAIN) {
       MarkDisconnected(errno);  // ENODEV: gone; EIO: the stream failed; EPIPE: it ended
       return Dequeued::kFailed;
@@ -863,11 +935,13 @@ V4l2Camera::Dequeued V4l2Camera::DequeueOne(CameraFrame* frame, bool poll_error)
     return Queue(buffer.index) ? Dequeued::kSkipped : Dequeued::kFailed;
   };
   if ((buffer.flags & V4L2_BUF_FLAG_ERROR) != 0) return skip(error_buffers_);
-  if (buffer.bytesused < converter_->min_frame_bytes() || buffer.bytesused > slot.length) {
+  const uint32_t offset = request.data_offset();
+  const uint32_t used = request.bytes_used();
+  if (offset > used || used > slot.length || used - offset < converter_->min_frame_bytes()) {
     return skip(short_buffers_);
   }
   ImageView image;
-  if (!converter_->Convert(static_cast<const uint8_t*>(slot.start), buffer.bytesused,
+  if (!converter_->Convert(static_cast<const uint8_t*>(slot.start) + offset, used - offset,
                            static_cast<int>(buffer.index), &image)) {
     return skip(decode_errors_);
   }

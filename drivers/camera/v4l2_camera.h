@@ -4,8 +4,10 @@
 // A Video4Linux2 capture device (a MIPI CSI-2 sensor behind the board's
 // capture interface, a UVC camera; vivid on the HIL bench) as a MonoCamera.
 //
-// Start-up (the constructor) opens the node, checks it is a single-planar
-// capture device that streams, negotiates the exact format, size and frame
+// Start-up (the constructor) opens the node, checks it is a capture device
+// that streams (through the single-planar API, or the multi-planar one when
+// that is all the driver offers, as many SoC CSI-2 receivers do; formats
+// must then still be in one memory plane), negotiates the exact format, size and frame
 // interval, applies the controls, maps `buffer_count` buffers, queues them
 // and starts streaming. Anything wrong there throws V4l2CameraError naming
 // the device, what was asked, what the device has, and the system error.
@@ -205,6 +207,10 @@ class V4l2Camera final : public MonoCamera {
   /// none at either end: "Trigger Mode" -> "trigger_mode".
   static std::string NormalizeControlName(const std::string& name);
 
+  /// True when the device streams through the multi-planar API
+  /// (V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE).
+  bool multi_planar() const { return multi_planar_; }
+
   /// Most capture buffers a camera maps (VIDEO_MAX_FRAME).
   static constexpr int kMaxBuffers = 32;
 
@@ -247,6 +253,7 @@ class V4l2Camera final : public MonoCamera {
 
   V4l2CameraOptions options_;
   uint32_t fourcc_ = 0;
+  bool multi_planar_ = false;  ///< chosen from the capabilities at open
   std::size_t bytes_per_line_ = 0;
   std::size_t size_image_ = 0;
   int buffer_count_ = 0;

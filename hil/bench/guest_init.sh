@@ -24,7 +24,9 @@ done
 
 while read -r module; do
   case "$module" in
-    vivid.ko) params="n_devs=1 node_types=0x1" ;;  # one capture node: /dev/video0
+    # Two capture nodes: /dev/video0 single-planar, /dev/video1 multi-planar
+    # (as tests/hil/bench/v4l2_vivid_test.cc reloads it).
+    vivid.ko) params="n_devs=2 node_types=0x1,0x1 multiplanar=1,2" ;;
     *) params="" ;;
   esac
   insmod "/modules/$module" $params || fail "insmod $module"

@@ -3,9 +3,9 @@
 # qemu-system-x86_64 (TCG software emulation: KVM is not available on CI
 # machines), the bench initramfs, the host's filesystem read-only over 9p and
 # OUT writable at the same path. The command sees vcan0, vcan1 and vivid's
-# /dev/video0 and runs as root in the guest; it may write to OUT. Prints the
-# guest console and exits with the command's status (or 90+ for bench
-# failures, see below).
+# /dev/video0 (single-planar) and /dev/video1 (multi-planar), and runs as
+# root in the guest; it may write to OUT. Prints the guest console and exits
+# with the command's status (or 90+ for bench failures, see below).
 #
 # usage: run_in_vm.sh --initramfs FILE --out DIR [--memory-mb N] [--cpus N]
 #                     [--timeout-s S] [--env NAME=VALUE]... -- COMMAND [ARGS...]

@@ -1,8 +1,8 @@
 // V4L2 scenarios on the HIL bench: run inside the bench VM (Debian's kernel
-// with vivid loaded as one capture node, /dev/video0; see
-// hil/bench/README.md) by ctest through rover_add_hil_vm_test. Every frame
-// crosses the kernel: vivid's kernel thread draws it into a vb2 buffer that
-// V4l2Camera dequeues from its memory mapping.
+// with vivid loaded as two capture nodes: /dev/video0 single-planar,
+// /dev/video1 multi-planar; see hil/bench/README.md) by ctest through rover_add_hil_vm_test. Every
+// frame crosses the kernel: vivid's kernel thread draws it into a vb2 buffer that V4l2Camera
+// dequeues from its memory mapping.
 //
 // vivid's own controls drive the faults: "percentage_of_dropped_buffers",
 // "inject_v4l2_buf_flag_error", "inject_fatal_streaming_error",
@@ -46,14 +46,18 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 constexpr const char* kDevice = "/dev/video0";
+/// A vivid instance that offers only the multi-planar capture API.
+constexpr const char* kMultiPlanarDevice = "/dev/video1";
+/// As hil/bench/guest_init.sh loads vivid.
+constexpr const char* kVividParameters = "n_devs=2 node_types=0x1,0x1 multiplanar=1,2";
 constexpr Duration kWait = Duration::Seconds(5);
 
 /// Writes one of vivid's controls through a descriptor of its own (closed
 /// again, so nothing keeps the module busy). Fails the test if the control
 /// is missing or refused.
-void SetVividControl(const std::string& name, int64_t value) {
-  const int fd = open(kDevice, O_RDWR | O_NONBLOCK | O_CLOEXEC);
-  ASSERT_GE(fd, 0) << kDevice << ": " << std::strerror(errno);
+void SetVividControl(const std::string& name, int64_t value, const char* device = kDevice) {
+  const int fd = open(device, O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  ASSERT_GE(fd, 0) << device << ": " << std::strerror(errno);
   bool done = false;
   uint32_t id = V4L2_CTRL_FLAG_NEXT_CTRL;
   for (int i = 0; i < 1000 && !done; ++i) {
@@ -79,9 +83,10 @@ void SetVividControl(const std::string& name, int64_t value) {
 
 void Shell(const std::string& command) { ASSERT_EQ(std::system(command.c_str()), 0) << command; }
 
-V4l2CameraOptions Options(const std::string& format, double rate_hz = 25.0, int buffers = 4) {
+V4l2CameraOptions Options(const std::string& format, double rate_hz = 25.0, int buffers = 4,
+                          const char* device = kDevice) {
   V4l2CameraOptions o;
-  o.device = kDevice;
+  o.device = device;
   o.pixel_format = format;
   o.width_px = 640;
   o.height_px = 480;
@@ -189,11 +194,13 @@ class VividTest : public ::testing::Test {
   // vivid keeps its control values across opens: every scenario starts
   // from the defaults it relies on.
   void SetUp() override {
-    SetVividControl("timestamp_source", 0);  // end of frame
-    SetVividControl("percentage_of_dropped_buffers", 0);
-    SetVividControl("wrap_sequence_number", 0);
-    SetVividControl("test_pattern", 0);   // 75% colour bar
-    SetVividControl("osd_text_mode", 2);  // no text over the bars
+    for (const char* device : {kDevice, kMultiPlanarDevice}) {
+      SetVividControl("timestamp_source", 0, device);  // end of frame
+      SetVividControl("percentage_of_dropped_buffers", 0, device);
+      SetVividControl("wrap_sequence_number", 0, device);
+      SetVividControl("test_pattern", 0, device);   // 75% colour bar
+      SetVividControl("osd_text_mode", 2, device);  // no text over the bars
+    }
   }
 };
 
@@ -669,6 +676,82 @@ TEST_F(VividTest, NextAndReleaseDoNotAllocate) {
 }
 
 // ---------------------------------------------------------------------------
+// The multi-planar API. /dev/video1 offers only
+// V4L2_CAP_VIDEO_CAPTURE_MPLANE, as many SoC CSI-2 receivers do: every
+// format, buffer and stream ioctl then takes the _MPLANE type and describes
+// its memory in v4l2_plane entries.
+
+// The same formats as the single-planar device, and the same pixels.
+TEST_F(VividTest, MultiPlanarDeviceGivesTheSameImagesAsTheSinglePlanarOne) {
+  for (const std::string format : {"GREY", "YUYV", "Y16"}) {
+    SCOPED_TRACE(format);
+    V4l2Camera single(Options(format));
+    EXPECT_FALSE(single.multi_planar());
+    const Image reference = Grab(single);
+    V4l2Camera camera(Options(format, 25.0, 4, kMultiPlanarDevice));
+    EXPECT_TRUE(camera.multi_planar());
+    EXPECT_EQ(FourccToString(camera.fourcc()), format);
+    EXPECT_EQ(camera.bytes_per_line(), single.bytes_per_line());
+    EXPECT_DOUBLE_EQ(camera.frame_rate_hz(), 25.0);
+    const Image image = Grab(camera);
+    ASSERT_EQ(image.width_px, 640);
+    ASSERT_EQ(image.height_px, 480);
+    EXPECT_EQ(BarLuma(image, 240), BarLuma(reference, 240));
+    EXPECT_EQ(camera.stats().short_buffers, 0u);
+  }
+}
+
+// Sequence, stamps, device drops and error buffers are read from the
+// multi-planar buffers as from single-planar ones, with no allocation.
+TEST_F(VividTest, MultiPlanarStreamCountsDropsAndErrorsWithoutAllocating) {
+  V4l2Camera camera(Options("GREY", 25.0, 4, kMultiPlanarDevice));
+  CameraFrame frame, previous;
+  ASSERT_EQ(camera.Next(&frame, kWait), ReadStatus::kOk);
+  previous = frame;
+  camera.Release(frame);
+  CountingCamera counting{camera};
+  uint64_t lost = 0;
+  auto stream = [&](int frames) {
+    for (int i = 0; i < frames; ++i) {
+      ASSERT_EQ(counting.Next(&frame, kWait), ReadStatus::kOk) << "frame " << i;
+      ASSERT_EQ(frame.sequence, previous.sequence + 1 + frame.dropped_before);
+      ASSERT_GT(frame.stamp, previous.stamp);
+      EXPECT_EQ(frame.image.width_px, 640);
+      lost += frame.dropped_before;
+      previous = frame;
+      counting.Release(frame);
+    }
+  };
+  ASSERT_NO_FATAL_FAILURE(stream(30));
+  camera.SetControl("percentage_of_dropped_buffers", 50);
+  ASSERT_NO_FATAL_FAILURE(stream(20));
+  camera.SetControl("percentage_of_dropped_buffers", 0);
+  const uint64_t lost_while_dropping = lost;
+  camera.SetControl("inject_v4l2_buf_flag_error", 1);
+  ASSERT_NO_FATAL_FAILURE(stream(10));
+  const V4l2CameraStats s = camera.stats();
+  std::printf("multi-planar: %llu frames, %llu lost (%llu while vivid dropped half)\n",
+              static_cast<unsigned long long>(s.frames), static_cast<unsigned long long>(lost),
+              static_cast<unsigned long long>(lost_while_dropping));
+  EXPECT_GE(lost_while_dropping, 5u);
+  EXPECT_EQ(s.frames, 61u);
+  EXPECT_EQ(s.dropped_frames, lost);
+  EXPECT_EQ(s.error_buffers, 1u);
+  EXPECT_EQ(s.foreign_clock_stamps, 0u);
+  EXPECT_EQ(s.backward_stamps, 0u);
+  EXPECT_EQ(counting.mallocs, 0u);
+}
+
+// A refused format lists what the device offers through the multi-planar
+// format enumeration (the single-planar one lists nothing here).
+TEST_F(VividTest, MultiPlanarRefusalListsTheDeviceFormats) {
+  const std::string message = StartupError(Options("MJPG", 25.0, 4, kMultiPlanarDevice));
+  EXPECT_THAT(message, AllOf(HasSubstr(kMultiPlanarDevice), HasSubstr("MJPG 640x480"),
+                             HasSubstr("not available"), HasSubstr("GREY 320x180"),
+                             HasSubstr("YUYV 320x180")));
+}
+
+// ---------------------------------------------------------------------------
 // Failures of the stream and of the device.
 
 // vivid fails the queue (vb2_queue_error): DQBUF answers EIO. The camera
@@ -759,7 +842,7 @@ TEST_F(VividTest, ZDeviceDisappearsAndComesBack) {
   for (int i = 0; i < 3; ++i) EXPECT_EQ(counting.Next(&frame, timeout), ReadStatus::kError);
   EXPECT_EQ(camera.stats().reconnects, 1u);
   EXPECT_EQ(camera.stats().last_errno, ENOENT) << "reopen attempts find no device node";
-  Shell("/usr/sbin/modprobe vivid n_devs=1 node_types=0x1");
+  Shell(std::string("/usr/sbin/modprobe vivid ") + kVividParameters);
   SetUp();  // the fresh module has default controls; every scenario expects these
   status = ReadStatus::kError;
   for (int i = 0; i < 30 && status != ReadStatus::kOk; ++i)
