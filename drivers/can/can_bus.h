@@ -11,6 +11,12 @@ namespace rover::drivers {
 class CanBus {
  public:
   virtual ~CanBus() = default;
+  /// Starts delivering frames, once, just before the reader's loop (start-up:
+  /// may block). Frames that arrived before are not delivered: the drives
+  /// send whether or not anyone listens, and a backlog from the process's
+  /// start-up would overflow the receive queue and be stale anyway.
+  /// Default: nothing to do.
+  virtual void Start() {}
   /// Waits up to `timeout` for the next frame.
   virtual ReadStatus Receive(CanFrame* frame, Duration timeout) = 0;
   /// Queues a frame for sending; false if the bus refused it.

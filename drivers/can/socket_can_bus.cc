@@ -162,6 +162,14 @@ int SocketCanBus::OpenSocket(const char** step) const {
   return fd;
 }
 
+void SocketCanBus::Start() {
+  if (fd_ >= 0) close(fd_);
+  const char* step = "";
+  fd_ = OpenSocket(&step);
+  last_drop_count_ = 0;
+  if (fd_ < 0) MarkDown();
+}
+
 int SocketCanBus::receive_buffer_bytes() const {
   if (fd_ < 0) return 0;
   int bytes = 0;

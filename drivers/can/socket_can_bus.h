@@ -114,6 +114,10 @@ class SocketCanBus final : public CanBus {
   /// health and counters and are not returned. kError when the interface is
   /// down (it is reopened on later calls).
   ReadStatus Receive(CanFrame* frame, Duration timeout) override;
+  /// Replaces the socket with a fresh one, so that the frames queued since
+  /// construction (and the kernel drops among them) are forgotten. If the
+  /// interface is gone by now, Receive() reopens it as after any outage.
+  void Start() override;
   /// Writes one frame; false (and counted) if the kernel refuses it, e.g.
   /// with a full transmit queue (ENOBUFS) or while the interface is down.
   bool Send(const CanFrame& frame) override;

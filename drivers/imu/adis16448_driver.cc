@@ -184,9 +184,20 @@ ReadStatus Adis16448Driver::Read(ImuSample* sample, Duration timeout) {
   }
 }
 
+void Adis16448Driver::Start() {
+  // Bounded: the kernel queues 16 line events; more can only be new ones.
+  constexpr int kMaxQueuedEdges = 64;
+  GpioEdge edge;
+  for (int i = 0; i < kMaxQueuedEdges; ++i) {
+    if (data_ready_.Wait(&edge, Duration::Zero()) != ReadStatus::kOk) break;
+  }
+  have_edge_ = false;
+  lost_edges_before_start_ = data_ready_.lost_edges();
+}
+
 Adis16448Stats Adis16448Driver::stats() const {
   Adis16448Stats s = stats_;
-  s.lost_edges = data_ready_.lost_edges();
+  s.lost_edges = data_ready_.lost_edges() - lost_edges_before_start_;
   return s;
 }
 

@@ -74,6 +74,10 @@ class Adis16448Driver final : public ImuDriver {
   /// left. kTimeout if no good sample came in time; kError if the edge
   /// source failed.
   ReadStatus Read(ImuSample* sample, Duration timeout) override;
+  /// Forgets the data-ready edges queued since construction (and the edges
+  /// the kernel lost among them). The sensor keeps only its newest sample:
+  /// a burst read for a queued edge would pair old stamps with new data.
+  void Start() override;
 
   /// Health counters so far. Call from the reading thread.
   Adis16448Stats stats() const;
@@ -95,6 +99,7 @@ class Adis16448Driver final : public ImuDriver {
   std::array<uint8_t, 2 + Adis16448Burst::Bytes(true)> rx_{};
   Adis16448Burst burst_;
   bool have_edge_ = false;
+  uint64_t lost_edges_before_start_ = 0;
   Time last_edge_;
   uint64_t sequence_ = 0;
   Adis16448Stats stats_{};

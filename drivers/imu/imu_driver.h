@@ -14,6 +14,12 @@ namespace rover::drivers {
 class ImuDriver {
  public:
   virtual ~ImuDriver() = default;
+  /// Starts the sample stream, once, just before the IMU loop reads it
+  /// (start-up: may block and throw). A device that streams into a small
+  /// kernel buffer (a serial line holds about 2 s at 400 Hz) must not start
+  /// while the rest of the process is still opening devices, or the start
+  /// of the stream is lost. Default: the stream needs no start.
+  virtual void Start() {}
   /// Waits up to `timeout` for the next sample.
   virtual ReadStatus Read(ImuSample* sample, Duration timeout) = 0;
 };

@@ -197,15 +197,25 @@ void XsensMtiDriver::Configure() {
     }
   }
 
-  Request(xbus::mid::kGoToMeasurement, {}, xbus::mid::kGoToMeasurementAck, "GoToMeasurement");
+  if (!options_.defer_measurement) GoToMeasurement();
 
   const std::string line = "Xsens MTi on " + port_.path() + ": device id " + Hex(device_id_, 8) +
-                           ", measuring at " + std::to_string(rate) + " Hz";
+                           (measuring_ ? ", measuring at " : ", configured for ") +
+                           std::to_string(rate) + " Hz";
   if (options_.log) {
     options_.log(line);
   } else {
     std::fprintf(stderr, "%s\n", line.c_str());
   }
+}
+
+void XsensMtiDriver::GoToMeasurement() {
+  Request(xbus::mid::kGoToMeasurement, {}, xbus::mid::kGoToMeasurementAck, "GoToMeasurement");
+  measuring_ = true;
+}
+
+void XsensMtiDriver::Start() {
+  if (!measuring_) GoToMeasurement();
 }
 
 bool XsensMtiDriver::ToSample(const MtData2Packet& packet, ImuSample* sample) {

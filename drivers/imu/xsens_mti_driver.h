@@ -35,6 +35,11 @@ struct XsensMtiOptions {
   Duration latency_correction = Duration::Zero();
   /// Start-up messages (the device id). Null: written to stderr.
   std::function<void(const std::string&)> log;
+  /// True: construction leaves the device in configuration mode and Start()
+  /// sends GoToMeasurement, so that nothing streams (and overflows the
+  /// serial line's buffer) before the reader is ready. False: construction
+  /// starts the measurement, for a reader that follows at once.
+  bool defer_measurement = false;
 
   /// Throws std::invalid_argument naming the field, the expected range and
   /// the value found.
@@ -100,6 +105,9 @@ class XsensMtiDriver final : public ImuDriver {
   /// checksum, other messages and malformed packets are counted and skipped
   /// within the same call.
   ReadStatus Read(ImuSample* sample, Duration timeout) override;
+  /// With defer_measurement, GoToMeasurement (throws ImuDeviceError like the
+  /// handshake); otherwise, or when measuring already, nothing.
+  void Start() override;
 
   /// Health counters so far. Safe to call from the reading thread only.
   XsensMtiStats stats() const;
@@ -112,6 +120,7 @@ class XsensMtiDriver final : public ImuDriver {
   std::vector<uint8_t> Request(uint8_t mid, std::span<const uint8_t> payload, uint8_t ack_mid,
                                const char* step);
   void Configure();
+  void GoToMeasurement();
   // Reads what the port has into the parser; false on error or hang-up.
   // `*timed_out` is set if nothing arrived before `deadline`.
   bool ReadInto(Time deadline, bool* timed_out);
@@ -123,6 +132,7 @@ class XsensMtiDriver final : public ImuDriver {
   XbusParser parser_;
   ClockOffsetTracker clock_;
   uint64_t device_id_ = 0;
+  bool measuring_ = false;
   Time last_read_time_;  // when the bytes now in the parser had arrived (upper bound)
 
   bool have_packet_ = false;

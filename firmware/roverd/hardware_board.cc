@@ -37,6 +37,23 @@ std::string SensorYaml(const std::string& folder, const std::string& sensor) {
   return path.string();
 }
 
+/// A camera's calibration, which must be for the image size the camera is
+/// set to: the intrinsics of another size would be silently wrong.
+drivers::CameraCalibration CameraCalibrationFor(const std::string& folder,
+                                                const std::string& sensor,
+                                                const runtime::BoardCameraOptions& camera) {
+  const std::string path = SensorYaml(folder, sensor);
+  drivers::CameraCalibration c = drivers::LoadCameraCalibration(path);
+  if (c.width_px != camera.width_px || c.height_px != camera.height_px) {
+    throw std::invalid_argument(
+        "hardware.camera.width_px: " + path + " calibrates " + sensor + " at " +
+        std::to_string(c.width_px) + "x" + std::to_string(c.height_px) +
+        " (resolution), expected the camera's " + std::to_string(camera.width_px) + "x" +
+        std::to_string(camera.height_px));
+  }
+  return c;
+}
+
 std::unique_ptr<drivers::MonoCamera> OpenCamera(const runtime::BoardCameraOptions& c,
                                                 const std::string& which) {
   const bool triggered = c.trigger.has_value();
@@ -84,26 +101,34 @@ HardwareBoard::HardwareBoard(const runtime::BoardHardwareOptions& options) {
   if (options.camera) {
     const Eigen::Isometry3d T_imu_body = imu.T_body_imu.inverse();
     CameraSetup head;
-    head.cam0 = ToCameraModel(
-        drivers::LoadCameraCalibration(SensorYaml(options.calibration, "cam0")), T_imu_body);
-    head.cam1 = ToCameraModel(
-        drivers::LoadCameraCalibration(SensorYaml(options.calibration, "cam1")), T_imu_body);
+    head.cam0 = ToCameraModel(CameraCalibrationFor(options.calibration, "cam0", *options.camera),
+                              T_imu_body);
+    head.cam1 = ToCameraModel(CameraCalibrationFor(options.calibration, "cam1", *options.camera),
+                              T_imu_body);
     if (!options.vo_config.empty()) {
       head.vo = estimator::vo::StereoOdometryOptions::LoadFile(options.vo_config);
     }
     head.vo.checks.nominal_rate_hz = options.camera->rate_hz;
     options_.camera = head;
   }
-  OpenImu(options.imu);
+  // Every device streams from the moment it is opened, into a buffer that
+  // holds only so much until roverd's threads read it: a camera's few
+  // capture buffers (its frames then count as lost in the device), the CAN
+  // socket's queue (about a second of the drives), the IMU's serial line
+  // (a few kilobytes). Slow openers go first (GigE discovery, V4L2
+  // negotiation), the IMU, which must lose nothing, last.
   if (options.camera) OpenCameras(*options.camera);
-  if (options.can) {
-    drivers::SocketCanOptions can;
-    can.interface = options.can->interface;
-    can.filters = drivers::SocketCanOptions::WheelDriveFilters();
-    can_ = std::make_unique<drivers::SocketCanBus>(can);
-    description_ += "  can     " + can.interface + " (SocketCAN, wheel-drive filters, " +
-                    std::to_string(can_->receive_buffer_bytes() / 1024) + " KiB receive buffer)\n";
-  }
+  if (options.can) OpenCan(*options.can);
+  OpenImu(options.imu);
+}
+
+void HardwareBoard::OpenCan(const runtime::BoardCanOptions& options) {
+  drivers::SocketCanOptions can;
+  can.interface = options.interface;
+  can.filters = drivers::SocketCanOptions::WheelDriveFilters();
+  can_ = std::make_unique<drivers::SocketCanBus>(can);
+  description_ += "  can     " + can.interface + " (SocketCAN, wheel-drive filters, " +
+                  std::to_string(can_->receive_buffer_bytes() / 1024) + " KiB receive buffer)\n";
 }
 
 HardwareBoard::~HardwareBoard() = default;
@@ -115,6 +140,7 @@ void HardwareBoard::OpenImu(const runtime::BoardImuOptions& imu) {
     o.baud_rate = imu.baud_rate;
     o.rate_hz = imu.rate_hz;
     o.log = [](const std::string&) {};  // the id goes into the description below
+    o.defer_measurement = true;         // streams from roverd's StartDevices()
     auto xsens = std::make_unique<drivers::XsensMtiDriver>(o);
     char id[16];
     std::snprintf(id, sizeof id, "0x%08X", static_cast<unsigned>(xsens->device_id()));
@@ -147,9 +173,17 @@ void HardwareBoard::OpenCameras(const runtime::BoardCameraOptions& camera) {
   pairing.stamp_tolerance = Duration::FromSeconds(camera.pair_tolerance_s);
   stereo_ = std::make_unique<drivers::StereoPairer>(cam0_.get(), cam1_.get(), pairing);
   const char* kind = camera.driver == runtime::CameraDriverKind::kV4l2 ? "V4L2" : "Aravis";
-  description_ += "  camera  " + std::string(kind) + " " + camera.cam0 + " + " + camera.cam1 +
-                  ", " + std::to_string(camera.width_px) + "x" + std::to_string(camera.height_px) +
-                  " " + camera.pixel_format + "\n";
+  // Which V4L2 API each node speaks: worth knowing when a board's capture
+  // driver changes.
+  auto api = [](const drivers::MonoCamera& c) -> std::string {
+    const auto* v4l2 = dynamic_cast<const drivers::V4l2Camera*>(&c);
+    return v4l2 != nullptr && v4l2->multi_planar() ? " (multi-planar)" : "";
+  };
+  description_ += "  camera  " + std::string(kind) + " " + camera.cam0 + api(*cam0_) + " + " +
+                  camera.cam1 + api(*cam1_) + ", " + std::to_string(camera.width_px) + "x" +
+                  std::to_string(camera.height_px) + " " + camera.pixel_format +
+                  ", paired within " +
+                  std::to_string(static_cast<int>(camera.pair_tolerance_s * 1e3 + 0.5)) + " ms\n";
   if (camera.trigger) {
     trigger_chip_ = std::make_unique<drivers::LibgpiodChip>(camera.trigger->chip);
     drivers::GpioCameraTriggerOptions t;
@@ -161,6 +195,29 @@ void HardwareBoard::OpenCameras(const runtime::BoardCameraOptions& camera) {
     description_ += "  trigger " + camera.trigger->chip + " line " +
                     std::to_string(camera.trigger->line) + " at " + Hz(camera.rate_hz) + "\n";
   }
+}
+
+std::string HardwareBoard::DeviceReport() const {
+  std::string report;
+  if (stereo_) {
+    const drivers::StereoPairerStats& s = stereo_->stats();
+    report += "  stereo  " + std::to_string(s.pairs) + " pairs";
+    for (int cam = 0; cam < 2; ++cam) {
+      const drivers::StereoPairerCameraStats& c = s.camera[cam];
+      report += "; cam" + std::to_string(cam) + " " + std::to_string(c.frames) + " frames (" +
+                std::to_string(c.unpaired) + " unpaired, " + std::to_string(c.device_dropped) +
+                " lost in the device, " + std::to_string(c.errors) + " errors)";
+    }
+    report += "; " + std::to_string(s.stamp_mismatches) + " stamp mismatches\n";
+  }
+  if (can_) {
+    const drivers::SocketCanStats s = can_->stats();
+    report += "  bus     " + can_->interface() + " " + drivers::ToString(can_->health()) + ": " +
+              std::to_string(s.frames) + " frames, " + std::to_string(s.kernel_drops) +
+              " kernel drops, " + std::to_string(s.error_frames) + " error frames, " +
+              std::to_string(s.bus_off) + " bus-off, " + std::to_string(s.reopens) + " reopens\n";
+  }
+  return report;
 }
 
 RoverdDrivers HardwareBoard::drivers() {

@@ -19,6 +19,7 @@
 
 #include "drivers/camera/mono_camera.h"
 #include "drivers/camera/stereo_camera_driver.h"
+#include "drivers/camera/stereo_pairer.h"
 #include "drivers/can/socket_can_bus.h"
 #include "drivers/gpio/gpio_chip.h"
 #include "drivers/gpio/gpio_edge_source.h"
@@ -45,24 +46,29 @@ class HardwareBoard {
   const RoverdOptions& options() const { return options_; }
   /// One line per device opened, for the start-up log.
   const std::string& description() const { return description_; }
+  /// The devices' own counters, a line per device group, for the exit
+  /// summary: stereo pairing per camera, the CAN bus. Call after roverd's
+  /// threads have stopped.
+  std::string DeviceReport() const;
 
  private:
   void OpenImu(const runtime::BoardImuOptions& imu);
   void OpenCameras(const runtime::BoardCameraOptions& camera);
+  void OpenCan(const runtime::BoardCanOptions& can);
 
   RoverdOptions options_;
   std::string description_;
   // The devices, in the order they are opened (and closed in reverse).
+  std::unique_ptr<drivers::MonoCamera> cam0_;
+  std::unique_ptr<drivers::MonoCamera> cam1_;
+  std::unique_ptr<drivers::StereoPairer> stereo_;
+  std::unique_ptr<drivers::GpioChip> trigger_chip_;
+  std::unique_ptr<drivers::CameraTrigger> trigger_;
+  std::unique_ptr<drivers::SocketCanBus> can_;
   std::unique_ptr<drivers::GpioChip> data_ready_chip_;
   std::unique_ptr<drivers::GpioEdgeSource> data_ready_;
   std::unique_ptr<drivers::SpiDevice> spi_;
   std::unique_ptr<drivers::ImuDriver> imu_;
-  std::unique_ptr<drivers::MonoCamera> cam0_;
-  std::unique_ptr<drivers::MonoCamera> cam1_;
-  std::unique_ptr<drivers::StereoCameraDriver> stereo_;
-  std::unique_ptr<drivers::GpioChip> trigger_chip_;
-  std::unique_ptr<drivers::CameraTrigger> trigger_;
-  std::unique_ptr<drivers::SocketCanBus> can_;
 };
 
 }  // namespace rover::roverd

@@ -79,6 +79,12 @@ void Roverd::Stop() {
   gate_.Stop();
 }
 
+void Roverd::StartDevices() {
+  // The IMU last: it is read first, the moment Run() begins.
+  if (drivers_.can != nullptr) drivers_.can->Start();
+  drivers_.imu->Start();
+}
+
 RoverdStats Roverd::Run() {
   const auto start = [this](runtime::RtThreadOptions options, std::function<void()> body) {
     if (options_.lockstep) options.priority = 0;  // the threads wait on each other

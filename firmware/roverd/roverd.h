@@ -150,6 +150,11 @@ class Roverd {
   Roverd(const Roverd&) = delete;
   Roverd& operator=(const Roverd&) = delete;
 
+  /// Starts the streams of the devices that must not run ahead of their
+  /// reader (ImuDriver::Start, CanBus::Start): call once, last thing before
+  /// Run(), on a thread that may block and throw (the drivers' start-up
+  /// errors). Without it the devices stream from their construction on.
+  void StartDevices();
   /// Runs the IMU loop on the calling thread until the IMU stream ends or
   /// Stop() is called, then stops the other threads and returns the totals.
   RoverdStats Run();

@@ -136,6 +136,7 @@ int main(int argc, char** argv) {
               << (replay ? "replayed from " + board.replay->dataset : std::string("from the IMU"))
               << "\n";
     rover::roverd::PrintRoverdStats(result.stats, result.mapd_link, std::cout);
+    if (hardware) std::cout << hardware->DeviceReport();
     std::cout << "  log     " << process.log_path << " (" << result.log.written << " records, "
               << result.log.dropped << " dropped); replay it with `rover replay "
               << process.log_path << "`\n";

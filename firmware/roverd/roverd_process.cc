@@ -75,6 +75,9 @@ RoverdProcess::~RoverdProcess() {
 
 RoverdProcessResult RoverdProcess::Run() {
   RoverdProcessResult result;
+  // Here, not in the IMU thread: a device that fails to start is an error
+  // for main() to report, like one that fails to open.
+  roverd_->StartDevices();
   if (lockstep_) {
     result.stats = roverd_->Run();
   } else {

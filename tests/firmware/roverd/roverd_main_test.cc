@@ -81,6 +81,20 @@ TEST(RoverdMainTest, UnusableProfilesExitWithExConfig) {
                                   "device: /dev/rover-no-such-tty}}\nlog: {folder: /tmp}\n");
   EXPECT_EQ(run.status.exit_code, 78) << run.output;
   EXPECT_NE(run.output.find("/dev/rover-no-such-tty"), std::string::npos) << run.output;
+  // A calibration for another image size than the camera's is refused
+  // before any device is opened.
+  run = RunRoverd(dir.path(), "board: {name: b, profile: hardware}\nhardware: {calibration: " +
+                                  std::string(source != nullptr ? source : ".") +
+                                  "/firmware/config/bench_calibration, imu: {driver: xsens, "
+                                  "device: /dev/rover-no-such-tty}, camera: {driver: v4l2, "
+                                  "cam0: /dev/video0, "
+                                  "cam1: /dev/video1, width_px: 752, height_px: 480}}\n"
+                                  "log: {folder: /tmp}\n");
+  EXPECT_EQ(run.status.exit_code, 78) << run.output;
+  EXPECT_NE(run.output.find("calibrates cam0 at 640x480 (resolution), expected the camera's "
+                            "752x480"),
+            std::string::npos)
+      << run.output;
   run = RunRoverd(dir.path(),
                   "board: {name: b, profile: replay}\nreplay: {dataset: /nonexistent}\n"
                   "log: {folder: /tmp}\n");

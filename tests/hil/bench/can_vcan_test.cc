@@ -437,6 +437,36 @@ TEST(CanVcanTest, StalledReceiverCountsKernelDropsAndRecovers) {
   EXPECT_EQ(rx.stats().kernel_drops, s.kernel_drops);
 }
 
+// Start() forgets what queued up, and overflowed, while the process was
+// still starting: the reader gets exactly the frames sent after it, and no
+// drops from before.
+TEST(CanVcanTest, StartForgetsTheBacklogAndItsDrops) {
+  SocketCanOptions options;
+  options.interface = "vcan0";
+  options.receive_buffer_bytes = 1;  // a few frames: 500 overflow it
+  SocketCanBus rx(options);
+  SocketCanBus tx("vcan0");
+  for (int i = 0; i < 500; ++i) ASSERT_TRUE(tx.Send(EncodeSync(Time::Now())));
+  rx.Start();
+  for (uint8_t i = 0; i < 3; ++i) {
+    CanFrame sent;
+    sent.id = kCanTpdo1BaseId + 1;
+    sent.dlc = 8;
+    sent.data[0] = i;
+    ASSERT_TRUE(tx.Send(sent));
+  }
+  CanFrame f;
+  for (uint8_t i = 0; i < 3; ++i) {
+    ASSERT_EQ(rx.Receive(&f, Duration::Seconds(2)), ReadStatus::kOk);
+    EXPECT_EQ(f.id, kCanTpdo1BaseId + 1) << "a frame from before Start()";
+    EXPECT_EQ(f.data[0], i);
+  }
+  EXPECT_EQ(rx.Receive(&f, Duration::Milliseconds(100)), ReadStatus::kTimeout);
+  EXPECT_EQ(rx.stats().kernel_drops, 0u);
+  EXPECT_EQ(rx.stats().frames, 3u);
+  EXPECT_EQ(rx.health(), CanBusHealth::kActive);
+}
+
 // After start-up the receive path does not touch the heap.
 TEST(CanVcanTest, ReceiveDoesNotAllocate) {
   SocketCanOptions options;

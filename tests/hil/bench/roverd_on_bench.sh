@@ -3,9 +3,11 @@
 # the HIL bench VM: its Xsens driver configures a simulated MTi on a pty pair
 # (`rover-sim mti`) over Xbus, its SocketCAN driver receives the simulated
 # wheel drives on vcan0 (`rover-sim can`), both streaming the `short`
-# scenario in real time. Passes when roverd took every IMU sample at 400 Hz
-# with none lost, decoded the wheel drives and fused them, logged it all,
-# and the log replays bit-exactly.
+# scenario in real time, and its stereo head is vivid's two capture nodes
+# (one single-planar, one multi-planar; 2 fps). Passes when roverd took
+# every IMU sample at 400 Hz with none lost, decoded the wheel drives and
+# fused them, paired the two cameras' frames and handed them to the VO and
+# the log, logged it all, and the log replays bit-exactly.
 #
 # usage (in the VM, from the source root): roverd_on_bench.sh BUILD_DIR OUT_DIR
 set -eu
@@ -51,7 +53,25 @@ wheels=$(sed -n 's/.*wheel speeds accepted \([0-9]*\).*/\1/p' "$out/roverd.log")
 [ "$sent" -ge $((stream_s * 400 - 40)) ] || fail "only $sent IMU samples in ${stream_s} s"
 [ "$periods" -ge $((stream_s * 100 / 2)) ] || fail "only $periods CAN SYNC periods decoded"
 [ "$wheels" -gt 0 ] || fail "no wheel speeds fused"
+
+# The stereo head: roverd ran at least as long as the simulators streamed.
+grep -q "^  camera  V4L2 /dev/video0 + /dev/video1 (multi-planar), 640x480 GREY" "$out/roverd.log" ||
+  fail "the stereo head was not opened as expected"
+frames=$(sed -n 's/^  camera  \([0-9]*\) frames, \([0-9]*\) dropped.*/\1/p' "$out/roverd.log")
+pairs=$(sed -n 's/^  stereo  \([0-9]*\) pairs.*/\1/p' "$out/roverd.log")
+unpaired0=$(sed -n 's/.*; cam0 [0-9]* frames (\([0-9]*\) unpaired.*/\1/p' "$out/roverd.log")
+unpaired1=$(sed -n 's/.*; cam1 [0-9]* frames (\([0-9]*\) unpaired.*/\1/p' "$out/roverd.log")
+images=$(sed -n 's/.* \([0-9]*\) images logged.*/\1/p' "$out/roverd.log")
+[ -n "$frames" ] && [ -n "$pairs" ] && [ -n "$unpaired0" ] && [ -n "$unpaired1" ] ||
+  fail "could not read the camera counts"
+[ "$pairs" -ge $((stream_s * 2 * 3 / 4)) ] || fail "only $pairs stereo pairs in over ${stream_s} s at 2 fps"
+[ "$frames" -eq "$pairs" ] || fail "roverd took $frames frames of $pairs pairs"
+# Free-running nodes: only the frames before both streams run are unpaired.
+[ "$unpaired0" -le 2 ] && [ "$unpaired1" -le 2 ] ||
+  fail "unpaired frames: cam0 $unpaired0, cam1 $unpaired1"
+[ "$images" -gt 0 ] || fail "no thumbnails logged"
 log=$(ls "$work"/logs/roverd-*.mcap)
+cp "$log" "$out/roverd.mcap"  # for a look from the host (rover-log info)
 "$build/host/replay/rover-replay" "$log" >"$out/replay.log" 2>&1 || fail "replay: $(cat "$out/replay.log")"
 cat "$out/replay.log"
-echo "roverd_on_bench: PASSED: $taken IMU samples (0 lost), $periods CAN periods, $wheels wheel speeds fused; log replays bit-exactly"
+echo "roverd_on_bench: PASSED: $taken IMU samples (0 lost), $periods CAN periods, $wheels wheel speeds fused, $pairs stereo pairs; log replays bit-exactly"

@@ -117,6 +117,28 @@ TEST(Adis16448SimTest, CountsMissedDataReadyEdges) {
   EXPECT_EQ(sequences[19], 22u);  // 20 and 21 are missing
 }
 
+// Edges queued while the process was still starting (here 10) belong to
+// samples the sensor no longer holds: Start() drops them, so the first
+// sample is the first edge after it, numbered 0, with its own data.
+TEST(Adis16448SimTest, StartForgetsTheEdgesQueuedBeforeIt) {
+  SimulatedAdis16448 device;
+  FakeDataReady data_ready(&device, kPeriod);
+  data_ready.EndAt(10);
+  Adis16448Driver driver(device, data_ready, Adis16448Options{});
+  driver.Start();
+  ImuSample s;
+  EXPECT_EQ(driver.Read(&s, kTimeout), ReadStatus::kTimeout) << "a queued edge was delivered";
+  data_ready.EndAt(20);
+  for (uint64_t k = 10; k < 20; ++k) {
+    ASSERT_EQ(driver.Read(&s, kTimeout), ReadStatus::kOk);
+    EXPECT_EQ(s.sequence, k - 10);
+    EXPECT_EQ(s.stamp, data_ready.start() + kPeriod * static_cast<int64_t>(k));
+    ExpectSample(s, device.SampleAt(k));
+  }
+  EXPECT_EQ(driver.stats().samples, 10u);
+  EXPECT_EQ(driver.stats().missed_edges, 0u);
+}
+
 TEST(Adis16448SimTest, IgnoresTheOtherEdgeOfTheDataReadyPulse) {
   SimulatedAdis16448 device;
   FakeDataReady data_ready(&device, kPeriod);

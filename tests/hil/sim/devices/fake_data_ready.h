@@ -43,7 +43,8 @@ class FakeDataReady final : public drivers::GpioEdgeSource {
 
   /// Sample instants with no edge.
   void Skip(uint64_t k) { missing_.insert(k); }
-  /// Edges stop (Wait times out) from sample k on.
+  /// Edges stop (Wait times out) from sample k on; a later EndAt() lets
+  /// them come again.
   void EndAt(uint64_t k) { end_ = k; }
   void EmitFallingEdges(bool on) { emit_falling_ = on; }
   Time start() const { return start_; }

@@ -102,6 +102,31 @@ TEST(XsensPtyTest, StreamsFourHundredHertzWithMonotonicStamps) {
   EXPECT_EQ(stats.non_monotonic_stamps, 0u);
 }
 
+// With defer_measurement the device is configured but silent until Start():
+// nothing streams into the serial line's buffer while roverd still opens
+// its other devices.
+TEST(XsensPtyTest, DeferredMeasurementStreamsOnlyFromStart) {
+  SimulatedMti mti(SimulatedMtiOptions{});
+  std::vector<std::string> log;
+  XsensMtiOptions options = DriverOptions(mti, &log);
+  options.defer_measurement = true;
+  XsensMtiDriver driver(options);
+  EXPECT_FALSE(mti.measuring());
+  ASSERT_EQ(log.size(), 1u);
+  EXPECT_NE(log[0].find("configured for 400 Hz"), std::string::npos) << log[0];
+  ImuSample s;
+  EXPECT_EQ(driver.Read(&s, Duration::Milliseconds(100)), ReadStatus::kTimeout);
+  driver.Start();
+  EXPECT_TRUE(mti.measuring());
+  driver.Start();  // once only: no second GoToMeasurement
+  EXPECT_EQ(mti.stats().messages, 4u);
+  for (int i = 0; i < 100; ++i) {
+    ASSERT_EQ(driver.Read(&s, kReadTimeout), ReadStatus::kOk);
+    EXPECT_EQ(s.sequence, static_cast<uint64_t>(i));
+  }
+  EXPECT_EQ(driver.stats().lost_samples, 0u);
+}
+
 TEST(XsensPtyTest, ConfiguresADeviceThatIsAlreadyStreaming) {
   SimulatedMtiOptions sim_options;
   sim_options.start_in_measurement = true;
