@@ -20,11 +20,7 @@
 // usage: bench_aravis_stream [--seconds 5] [--config FORMAT@FPS]...
 //        (default: Mono8@30 Mono8@100 Mono8@400 Mono16@100)
 
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
 #include <sys/resource.h>
-#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -44,8 +40,7 @@
 #include "core/time/time.h"
 #include "drivers/camera/aravis_camera.h"
 #include "drivers/camera/device_clock_fit.h"
-
-extern char** environ;
+#include "hil/sim/devices/fake_gv_camera_process.h"
 
 namespace {
 
@@ -54,7 +49,6 @@ using rover::Time;
 using rover::drivers::AravisCamera;
 using rover::drivers::AravisCameraOptions;
 using rover::drivers::AravisCameraStats;
-using rover::drivers::AravisDeviceInfo;
 using rover::drivers::CameraFrame;
 using rover::drivers::DeviceClockFit;
 using rover::drivers::ReadStatus;
@@ -100,21 +94,6 @@ double Percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   const auto index = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
   return v[std::min(index, v.size() - 1)];
-}
-
-pid_t StartFakeCamera(const std::string& serial) {
-  std::vector<std::string> args = {"arv-fake-gv-camera-0.8", "-i", "127.0.0.1", "-s", serial};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-  pid_t pid = -1;
-  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return rc == 0 ? pid : -1;
 }
 
 void RunConfig(const std::string& serial, pid_t fake_pid, const Config& config, double seconds) {
@@ -228,29 +207,13 @@ int main(int argc, char** argv) {
   }
 
   BenchClockFit();
-  const std::string serial = "BENCH" + std::to_string(getpid());
-  const pid_t fake = StartFakeCamera(serial);
-  if (fake <= 0) {
-    std::fprintf(stderr, "cannot start arv-fake-gv-camera-0.8 (package aravis-tools)\n");
+  rover::sim::FakeGvCameraProcess fake({.serial = "BENCH" + std::to_string(getpid())});
+  try {
+    fake.Start();
+    for (const Config& c : configs) RunConfig(fake.serial(), fake.pid(), c, seconds);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
     return 1;
   }
-  bool found = false;
-  for (int attempt = 0; attempt < 20 && !found; ++attempt) {
-    for (const AravisDeviceInfo& d : AravisCamera::ListDevices()) found |= d.serial == serial;
-  }
-  int status = 0;
-  if (!found) {
-    std::fprintf(stderr, "arv-fake-gv-camera-0.8 (serial %s) was not discovered\n", serial.c_str());
-    status = 1;
-  } else {
-    try {
-      for (const Config& c : configs) RunConfig(serial, fake, c, seconds);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "%s\n", e.what());
-      status = 1;
-    }
-  }
-  kill(fake, SIGKILL);
-  waitpid(fake, nullptr, 0);
-  return status;
+  return 0;
 }

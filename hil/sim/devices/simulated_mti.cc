@@ -249,8 +249,11 @@ void SimulatedMti::Handle(const xbus::Message& message) {
     }
     case xbus::mid::kGoToMeasurement:
       if (rate_hz_.load() == 0) break;  // nothing configured yet
-      Send(xbus::mid::kGoToMeasurementAck, {});
+      // Measuring before the acknowledge leaves: a driver that has it sees
+      // measuring() true. The first packet still follows the acknowledge,
+      // since this thread sends both.
       StartMeasurement(Time::Now());
+      Send(xbus::mid::kGoToMeasurementAck, {});
       return;
     case xbus::mid::kWakeUpAck:
       return;

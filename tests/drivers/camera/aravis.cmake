@@ -11,6 +11,6 @@ rover_add_test(NAME drivers_camera_clock_fit_test
 # a time, hence the lock. Not asan: links the malloc counter.
 rover_add_test(NAME hil_aravis_fake_gv_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/aravis_fake_gv_test.cc
-  LIBS rover_drivers rover_test_malloc_counter
+  LIBS rover_drivers rover_sim rover_test_malloc_counter
   LABELS hil
   RESOURCE_LOCK gige)

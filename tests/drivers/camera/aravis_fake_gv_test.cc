@@ -19,10 +19,6 @@
 // - killing it stops the heartbeat replies: Aravis reports "control-lost"
 //   after its heartbeat retries, about 6 s later.
 
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gmock/gmock.h>
@@ -32,91 +28,20 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "drivers/camera/aravis_camera.h"
+#include "hil/sim/devices/fake_gv_camera_process.h"
 #include "tests/support/malloc_counter.h"
-
-extern char** environ;
 
 namespace rover::drivers {
 namespace {
 
 using ::testing::HasSubstr;
 
-constexpr const char* kFakeCamera = "arv-fake-gv-camera-0.8";
-
-std::string FindFakeCamera() {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path != nullptr ? path : "/usr/bin:/bin";
-  std::size_t start = 0;
-  while (start <= dirs.size()) {
-    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
-    const std::filesystem::path candidate =
-        std::filesystem::path(dirs.substr(start, end - start)) / kFakeCamera;
-    if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
-    start = end + 1;
-  }
-  return {};
-}
-
-// One arv-fake-gv-camera-0.8 process on 127.0.0.1 with its own serial.
-class FakeGvCamera {
- public:
-  explicit FakeGvCamera(std::string serial, int lost_packets_per_thousand = 0)
-      : serial_(std::move(serial)), lost_per_thousand_(lost_packets_per_thousand) {}
-  ~FakeGvCamera() { Kill(); }
-  FakeGvCamera(const FakeGvCamera&) = delete;
-  FakeGvCamera& operator=(const FakeGvCamera&) = delete;
-
-  // Starts the process and waits until discovery sees it.
-  void Start() {
-    const std::string binary = FindFakeCamera();
-    ASSERT_FALSE(binary.empty()) << kFakeCamera << " not found in PATH (package aravis-tools)";
-    std::vector<std::string> args = {binary, "-i", "127.0.0.1", "-s", serial_};
-    if (lost_per_thousand_ > 0) {
-      args.push_back("-r");
-      args.push_back(std::to_string(lost_per_thousand_));
-    }
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    // Its warnings (unknown GVCP commands, heartbeat timeouts) are expected.
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-    const int rc = posix_spawn(&pid_, binary.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    ASSERT_EQ(rc, 0) << "cannot start " << binary;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    while (std::chrono::steady_clock::now() < deadline) {
-      for (const AravisDeviceInfo& d : AravisCamera::ListDevices()) {
-        if (d.serial == serial_) return;
-      }
-    }
-    FAIL() << kFakeCamera << " with serial " << serial_ << " was not discovered within 20 s";
-  }
-
-  void Kill() {
-    if (pid_ <= 0) return;
-    kill(pid_, SIGKILL);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-  }
-
-  const std::string& serial() const { return serial_; }
-  std::string device_id() const { return "Aravis-Fake-" + serial_; }
-
- private:
-  std::string serial_;
-  int lost_per_thousand_ = 0;
-  pid_t pid_ = -1;
-};
+using FakeGvCamera = sim::FakeGvCameraProcess;
 
 // A serial no other test (or other run on this machine) uses.
 std::string UniqueSerial() {
@@ -182,8 +107,8 @@ ReadStatus NextWithin(AravisCamera* camera, CameraFrame* frame, Duration budget)
 }
 
 TEST(AravisFakeGvTest, StreamsCompleteFramesAcrossTheFrameIdWrap) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCamera camera(OptionsFor(fake));
   EXPECT_EQ(camera.device_id(), fake.device_id());
   EXPECT_EQ(camera.payload_bytes(), 640u * 480u);
@@ -237,8 +162,8 @@ TEST(AravisFakeGvTest, StreamsCompleteFramesAcrossTheFrameIdWrap) {
 }
 
 TEST(AravisFakeGvTest, ConfiguredPacketSizeIsUsed) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   o.packet_size_bytes = 4000;  // 77 packets per frame instead of 220
   AravisCamera camera(o);
@@ -253,8 +178,8 @@ TEST(AravisFakeGvTest, ConfiguredPacketSizeIsUsed) {
 }
 
 TEST(AravisFakeGvTest, ExposureReachesTheCamera) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   // The simulator scales its pattern by 1 + log10(exposure / 10 ms).
   o.exposure_us = 100'000.0;
@@ -272,8 +197,8 @@ TEST(AravisFakeGvTest, ExposureReachesTheCamera) {
 }
 
 TEST(AravisFakeGvTest, HeldBuffersAreUnderrunsNotCorruption) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   o.buffer_count = 3;
   o.frame_rate_hz = 100.0;
@@ -298,8 +223,8 @@ TEST(AravisFakeGvTest, HeldBuffersAreUnderrunsNotCorruption) {
 }
 
 TEST(AravisFakeGvTest, Mono16IsConvertedToEightBits) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   // 8: the high byte (fast path); 4: 12-bit data, shifted and clamped.
   for (const int shift : {8, 4}) {
     SCOPED_TRACE(shift);
@@ -323,8 +248,8 @@ TEST(AravisFakeGvTest, Mono16IsConvertedToEightBits) {
 }
 
 TEST(AravisFakeGvTest, SoftwareTriggerGivesExactlyOneFramePerTrigger) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   o.trigger_enabled = true;
   o.trigger_source = "Software";
@@ -353,8 +278,8 @@ TEST(AravisFakeGvTest, SoftwareTriggerGivesExactlyOneFramePerTrigger) {
 }
 
 TEST(AravisFakeGvTest, PacketLossWithoutResendIsCountedAndTheStreamGoesOn) {
-  FakeGvCamera fake(UniqueSerial(), /*lost_packets_per_thousand=*/2);
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial(), .lost_packets_per_thousand = 2});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   o.packet_resend = false;
   AravisCamera camera(o);
@@ -398,8 +323,8 @@ TEST(AravisFakeGvTest, PacketLossWithoutResendIsCountedAndTheStreamGoesOn) {
 }
 
 TEST(AravisFakeGvTest, PacketLossWithResendRequestsResends) {
-  FakeGvCamera fake(UniqueSerial(), /*lost_packets_per_thousand=*/2);
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial(), .lost_packets_per_thousand = 2});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   o.packet_resend = true;
   AravisCamera camera(o);
@@ -431,11 +356,11 @@ TEST(AravisFakeGvTest, PacketLossWithResendRequestsResends) {
 }
 
 TEST(AravisFakeGvTest, DisconnectIsCountedNextStaysBoundedAndTheCameraComesBack) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   // Declared before the camera so that it outlives it: a camera destroyed
   // after its device died waits out Aravis's GVCP retries (~10 s).
-  FakeGvCamera again(fake.serial());
+  FakeGvCamera again({.serial = fake.serial()});
   AravisCameraOptions o = OptionsFor(fake);
   o.reconnect_initial_backoff = Duration::Milliseconds(100);
   o.reconnect_max_backoff = Duration::Milliseconds(800);
@@ -490,7 +415,7 @@ TEST(AravisFakeGvTest, DisconnectIsCountedNextStaysBoundedAndTheCameraComesBack)
   // Bounded by the timeout (plus scheduling slack on a loaded machine).
   EXPECT_LT(longest, timeout + Duration::Milliseconds(400)) << longest.ToString();
 
-  ASSERT_NO_FATAL_FAILURE(again.Start());
+  ASSERT_NO_THROW(again.Start());
   const Time restarted = Time::Now();
   ReadStatus status = ReadStatus::kError;
   const Time reconnect_deadline = Time::Now() + Duration::Seconds(60);
@@ -522,8 +447,8 @@ TEST(AravisFakeGvTest, DisconnectIsCountedNextStaysBoundedAndTheCameraComesBack)
 }
 
 TEST(AravisFakeGvTest, MissingDeviceGivesAnErrorNamingItAndListingTheOthers) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o;
   o.serial = "NO-SUCH-" + std::to_string(getpid());
   try {
@@ -549,8 +474,8 @@ TEST(AravisFakeGvTest, MissingDeviceGivesAnErrorNamingItAndListingTheOthers) {
 }
 
 TEST(AravisFakeGvTest, RefusedSettingsNameTheFeature) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   o.gain_db = 6.0;  // the simulator only has GainRaw
   try {
@@ -604,8 +529,8 @@ TEST(AravisFakeGvTest, OptionsAreValidatedNamingTheField) {
 }
 
 TEST(AravisFakeGvTest, NextAndReleaseDoNotAllocateAfterStartUp) {
-  FakeGvCamera fake(UniqueSerial());
-  ASSERT_NO_FATAL_FAILURE(fake.Start());
+  FakeGvCamera fake({.serial = UniqueSerial()});
+  ASSERT_NO_THROW(fake.Start());
   AravisCameraOptions o = OptionsFor(fake);
   o.frame_rate_hz = 100.0;
   AravisCamera camera(o);
