@@ -20,13 +20,15 @@ mkdir -p "$work/logs" "$out"
 
 fail() { echo "roverd_on_bench: FAILED: $*"; exit 1; }
 
-# Both simulators build the same world first (slow under emulation); started
-# together they stream at about the same time.
+# Both simulators build the same world first (slow under emulation). The
+# MTi streams for $stream_s s from roverd's GoToMeasurement, which roverd
+# sends once every device is open and its threads are ready; the drives send
+# from the moment their world is built, for the whole scenario (60 s, longer
+# than roverd takes to start), and are stopped when the MTi is done.
 "$build/hil/sim/rover-sim" mti --scenario short --link "$work/mti0" --max-duration-s "$stream_s" \
   >"$out/mti.log" 2>&1 &
 mti=$!
-"$build/hil/sim/rover-sim" can --scenario short --interface vcan0 --max-duration-s "$stream_s" \
-  >"$out/can.log" 2>&1 &
+"$build/hil/sim/rover-sim" can --scenario short --interface vcan0 >"$out/can.log" 2>&1 &
 can=$!
 i=0
 while [ ! -e "$work/mti0" ]; do
@@ -36,7 +38,9 @@ done
 "$build/firmware/roverd/roverd" --config firmware/config/bench.yaml --no-ipc >"$out/roverd.log" 2>&1 &
 roverd=$!
 wait $mti || fail "rover-sim mti failed: $(cat "$out/mti.log")"
-wait $can || fail "rover-sim can failed: $(cat "$out/can.log")"
+kill -0 $can 2>/dev/null || fail "rover-sim can ended before the MTi did: $(cat "$out/can.log")"
+kill $can
+wait $can 2>/dev/null || true
 sleep 1
 kill -INT $roverd
 wait $roverd || fail "roverd exited with status $?: $(cat "$out/roverd.log")"
