@@ -111,12 +111,12 @@ HardwareBoard::HardwareBoard(const runtime::BoardHardwareOptions& options) {
     head.vo.checks.nominal_rate_hz = options.camera->rate_hz;
     options_.camera = head;
   }
-  // Every device streams from the moment it is opened, into a buffer that
-  // holds only so much until roverd's threads read it: a camera's few
-  // capture buffers (its frames then count as lost in the device), the CAN
-  // socket's queue (about a second of the drives), the IMU's serial line
-  // (a few kilobytes). Slow openers go first (GigE discovery, V4L2
-  // negotiation), the IMU, which must lose nothing, last.
+  // Cameras stream from the moment they are opened into their few capture
+  // buffers (what does not fit counts as lost in the device); the CAN bus
+  // and the IMU start only in roverd's StartDevices(), once every thread is
+  // ready. Slow openers still go first (GigE discovery, V4L2 negotiation)
+  // and the IMU, which must lose nothing, last: a driver that cannot defer
+  // its stream then waits the least.
   if (options.camera) OpenCameras(*options.camera);
   if (options.can) OpenCan(*options.can);
   OpenImu(options.imu);
