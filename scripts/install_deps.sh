@@ -13,6 +13,7 @@ DEBIAN_PACKAGES=(
   build-essential            # GCC 12 toolchain (C++20)
   cmake                      # build system, >= 3.25 on Debian 12
   ninja-build                # generator used by every preset
+  ccache                     # compiler cache shared by every preset and every clone (cmake/RoverCcache.cmake)
   pkg-config                 # locates zstd / lz4 / yaml-cpp
   git                        # version stamp in logs, fresh-clone checks
   clang                      # libFuzzer targets (tests/fuzz)
