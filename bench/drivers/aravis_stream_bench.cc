@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stats/percentile.h"
 #include "core/time/time.h"
 #include "drivers/camera/aravis_camera.h"
 #include "drivers/camera/device_clock_fit.h"
@@ -87,13 +88,6 @@ double ChildCpuSeconds(pid_t pid) {
     if (i >= 14) ticks += std::strtod(field.c_str(), nullptr);
   }
   return ticks / static_cast<double>(sysconf(_SC_CLK_TCK));
-}
-
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto index = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
-  return v[std::min(index, v.size() - 1)];
 }
 
 void RunConfig(const std::string& serial, pid_t fake_pid, const Config& config, double seconds) {
@@ -149,11 +143,13 @@ void RunConfig(const std::string& serial, pid_t fake_pid, const Config& config, 
       "%.1f us, simulator %.1f us\n",
       process_cpu / n * 1e6, thread_cpu / n * 1e6, fake_cpu / n * 1e6);
   std::printf("  hand-over pop -> Next() return: p50 %.1f us, p99 %.1f us, max %.1f us\n",
-              Percentile(handover_us, 0.5), Percentile(handover_us, 0.99),
-              Percentile(handover_us, 1.0));
+              rover::stats::Percentile(handover_us, 50.0),
+              rover::stats::Percentile(handover_us, 99.0),
+              rover::stats::Percentile(handover_us, 100.0));
   std::printf("  delivery stamp -> Next() return: p50 %.0f us, p99 %.0f us, max %.0f us\n",
-              Percentile(delivery_us, 0.5), Percentile(delivery_us, 0.99),
-              Percentile(delivery_us, 1.0));
+              rover::stats::Percentile(delivery_us, 50.0),
+              rover::stats::Percentile(delivery_us, 99.0),
+              rover::stats::Percentile(delivery_us, 100.0));
   std::printf("  clock fit: drift %.1f ppm, mean excess latency %.0f us, resets %llu\n",
               after.clock_drift_ppm, static_cast<double>(after.clock_mean_residual_ns) * 1e-3,
               static_cast<unsigned long long>(after.clock_resets));

@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stats/percentile.h"
 #include "core/time/time.h"
 #include "drivers/camera/v4l2_camera.h"
 
@@ -112,13 +113,6 @@ Duration ThreadCpu(int pid) {
   return Duration::Nanoseconds(ns);
 }
 
-double Percentile(std::vector<int64_t> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const auto i = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1) + 0.5);
-  return static_cast<double>(values[std::min(i, values.size() - 1)]);
-}
-
 /// Streams one configuration and prints its row; false if it could not run.
 bool Run(const std::string& device, const Config& config, int frames, int buffers) {
   V4l2CameraOptions options;
@@ -182,10 +176,11 @@ bool Run(const std::string& device, const Config& config, int frames, int buffer
         "%-4s %5dx%-5d %6.2f | %7.2f %7.2f | %8.3f %8.2f | %7.1f %7.1f %7.1f | %7.2f %7.2f | "
         "%5" PRIu64 " %5" PRIu64 "\n",
         config.fourcc.c_str(), config.width_px, config.height_px, camera.frame_rate_hz(), stamp_fps,
-        wall_fps, cpu_ms, vivid_ms, Percentile(handover_ns, 0.5) * 1e-3,
-        Percentile(handover_ns, 0.99) * 1e-3,
+        wall_fps, cpu_ms, vivid_ms, rover::stats::Percentile(handover_ns, 50.0) * 1e-3,
+        rover::stats::Percentile(handover_ns, 99.0) * 1e-3,
         static_cast<double>(*std::max_element(handover_ns.begin(), handover_ns.end())) * 1e-3,
-        Percentile(delivery_ns, 0.5) * 1e-6, Percentile(delivery_ns, 0.99) * 1e-6, dropped,
+        rover::stats::Percentile(delivery_ns, 50.0) * 1e-6,
+        rover::stats::Percentile(delivery_ns, 99.0) * 1e-6, dropped,
         after.error_buffers - before.error_buffers);
     std::printf(
         "RESULT bench=v4l2_vivid format=%s size=%dx%d rate_hz=%.2f fps=%.2f cpu_ms_per_frame=%.3f "
@@ -193,9 +188,10 @@ bool Run(const std::string& device, const Config& config, int frames, int buffer
         "delivery_ms_p50=%.2f "
         "delivery_ms_p99=%.2f dropped=%" PRIu64 " checksum=%" PRIu64 "\n",
         config.fourcc.c_str(), config.width_px, config.height_px, config.rate_hz, stamp_fps, cpu_ms,
-        vivid_ms, Percentile(handover_ns, 0.5) * 1e-3, Percentile(handover_ns, 0.99) * 1e-3,
-        Percentile(delivery_ns, 0.5) * 1e-6, Percentile(delivery_ns, 0.99) * 1e-6, dropped,
-        checksum);
+        vivid_ms, rover::stats::Percentile(handover_ns, 50.0) * 1e-3,
+        rover::stats::Percentile(handover_ns, 99.0) * 1e-3,
+        rover::stats::Percentile(delivery_ns, 50.0) * 1e-6,
+        rover::stats::Percentile(delivery_ns, 99.0) * 1e-6, dropped, checksum);
     std::fflush(stdout);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_v4l2_vivid: %s\n", e.what());

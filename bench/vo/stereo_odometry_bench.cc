@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stats/percentile.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/stereo_odometry.h"
@@ -32,13 +33,6 @@ namespace rover::estimator::vo {
 namespace {
 
 using testing::ToModel;
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  return v[std::min(i, v.size() - 1)];
-}
 
 struct Options {
   std::string dataset = ROVER_VO_BENCH_DATA;
@@ -152,18 +146,18 @@ int Run(const Options& o) {
     double sum = 0.0;
     for (double x : v) sum += x;
     std::printf("  %-8s %8.2f %8.2f %8.2f %8.2f   ms\n", s.name,
-                sum / static_cast<double>(v.size()), Percentile(v, 0.5), Percentile(v, 0.99),
-                Percentile(v, 1.0));
+                sum / static_cast<double>(v.size()), stats::Percentile(v, 50.0),
+                stats::Percentile(v, 99.0), stats::Percentile(v, 100.0));
   }
   const std::vector<double> total = column(&VoStageTimes::total_ms);
-  const double ref_p50 = Percentile(reference, 0.5);
+  const double ref_p50 = stats::Percentile(reference, 50.0);
   std::printf("  reference (remap + pyramids + fwd/bwd KLT of %zu features): median %.2f ms\n",
               features.size(), ref_p50);
   std::printf(
       "RESULT vo_ms_p50=%.2f vo_ms_p99=%.2f budget_ms=25 p99_over_budget=%.2f "
       "reference_ms_p50=%.2f vo_over_reference=%.2f\n",
-      Percentile(total, 0.5), Percentile(total, 0.99), Percentile(total, 0.99) / 25.0, ref_p50,
-      Percentile(total, 0.5) / ref_p50);
+      stats::Percentile(total, 50.0), stats::Percentile(total, 99.0),
+      stats::Percentile(total, 99.0) / 25.0, ref_p50, stats::Percentile(total, 50.0) / ref_p50);
   return 0;
 }
 

@@ -1,10 +1,13 @@
 #include "drivers/gpio/gpio_loopback_check.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
+#include "core/stats/percentile.h"
 #include "drivers/gpio/gpio_camera_trigger.h"
 #include "drivers/gpio/gpio_line_edge_source.h"
 
@@ -21,13 +24,14 @@ GpioCameraTriggerOptions TriggerOptions(const GpioLoopbackOptions& o) {
   return t;
 }
 
-// Nearest-rank percentile of sorted values.
-Duration Percentile(const std::vector<Duration>& sorted, int percent) {
-  if (sorted.empty()) return Duration::Zero();
-  const std::size_t n = sorted.size();
-  std::size_t rank = (n * static_cast<std::size_t>(percent) + 99) / 100;
-  if (rank == 0) rank = 1;
-  return sorted[rank - 1];
+// A percentile of latencies, to the nanosecond.
+Duration PercentileDuration(const std::vector<Duration>& latencies, double percent) {
+  if (latencies.empty()) return Duration::Zero();
+  std::vector<int64_t> ns(latencies.size());
+  std::transform(latencies.begin(), latencies.end(), ns.begin(),
+                 [](Duration d) { return d.nanoseconds(); });
+  return Duration::Nanoseconds(
+      std::llround(stats::Percentile(std::span<const int64_t>(ns), percent)));
 }
 
 std::string Micros(Duration d) {
@@ -184,8 +188,8 @@ GpioLoopbackReport GpioLoopbackCheck::Run() {
   std::sort(widths.begin(), widths.end());
   if (!latencies.empty()) {
     report.latency_min = latencies.front();
-    report.latency_p50 = Percentile(latencies, 50);
-    report.latency_p99 = Percentile(latencies, 99);
+    report.latency_p50 = PercentileDuration(latencies, 50.0);
+    report.latency_p99 = PercentileDuration(latencies, 99.0);
     report.latency_max = latencies.back();
   }
   if (!widths.empty()) {

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/geometry/so3.h"
-#include "estimator/eval/chi_square.h"
+#include "core/stats/chi_square.h"
 
 namespace rover::eval {
 namespace {
@@ -31,8 +31,8 @@ Vector6d PoseError(const AssociatedPose& pose) {
 
 NeesResult ComputeNees(const std::vector<AssociatedPose>& poses) {
   NeesResult r;
-  const double lower = Chi2Quantile(3, 0.025);
-  const double upper = Chi2Quantile(3, 0.975);
+  const double lower = stats::Chi2Quantile(3, 0.025);
+  const double upper = stats::Chi2Quantile(3, 0.975);
   double sum_position = 0.0, sum_attitude = 0.0, sum_pose = 0.0;
   std::size_t position_in = 0, attitude_in = 0;
   for (const AssociatedPose& p : poses) {

@@ -13,6 +13,7 @@
 
 #include "core/log/flight/flight_log.h"
 #include "core/log/msgs/all_msgs.h"
+#include "core/stats/percentile.h"
 #include "core/time/posix_time.h"
 #include "hil/sim/world/world.h"
 
@@ -29,13 +30,6 @@ bool TrySetFifoPriority(int priority) {
   sched_param param{};
   param.sched_priority = priority;
   return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
-}
-
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
 }
 
 log::sensor_msgs::Imu MakeImuMessage(const drivers::ImuSample& m, const ImuModelOptions& imu) {
@@ -190,11 +184,11 @@ ImuMissionResult RunImuMission(const ImuMissionOptions& options, std::ostream& s
   result.wall_time_s = (Time::Now() - wall_start).ToSeconds();
   result.distance_m = distance_m;
   result.realtime_priority = realtime.load();
-  result.log_call_ns_p50 = Percentile(log_cost_ns, 0.5);
-  result.log_call_ns_p99 = Percentile(log_cost_ns, 0.99);
+  result.log_call_ns_p50 = stats::Percentile(log_cost_ns, 50.0);
+  result.log_call_ns_p99 = stats::Percentile(log_cost_ns, 99.0);
   result.log_call_ns_max =
       log_cost_ns.empty() ? 0.0 : *std::max_element(log_cost_ns.begin(), log_cost_ns.end());
-  result.tick_lateness_us_p99 = Percentile(lateness_us, 0.99);
+  result.tick_lateness_us_p99 = stats::Percentile(lateness_us, 99.0);
   return result;
 }
 

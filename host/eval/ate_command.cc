@@ -6,7 +6,7 @@
 
 #include "core/geometry/so3.h"
 #include "core/geometry/yaw.h"
-#include "estimator/eval/chi_square.h"
+#include "core/stats/chi_square.h"
 #include "estimator/eval/eval_error.h"
 #include "estimator/eval/tum_trajectory.h"
 #include "host/eval/report_format.h"
@@ -82,7 +82,8 @@ void PrintNees(const ev::NeesResult& nees, std::ostream& out) {
   if (nees.without_covariance > 0) out << ", " << nees.without_covariance << " without";
   if (nees.singular > 0) out << ", " << nees.singular << " not positive definite";
   out << ")\n";
-  const double lower = ev::Chi2Quantile(3, 0.025), upper = ev::Chi2Quantile(3, 0.975);
+  const double lower = rover::stats::Chi2Quantile(3, 0.025),
+               upper = rover::stats::Chi2Quantile(3, 0.975);
   TextTable table({"", "dof", "mean", "expected", "in 95% interval"});
   table.AddRow({"position", "3", Fixed(nees.mean_position, 3), "3",
                 Fixed(100.0 * nees.position_in_95, 1) + " %"});

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "estimator/eval/chi_square.h"
+#include "core/stats/chi_square.h"
 #include "estimator/eval/eval_error.h"
 #include "host/eval/report_format.h"
 
@@ -93,8 +93,8 @@ NeesSummary RunNeesExperiment(const NeesCommandOptions& options, std::ostream& e
       },
       err);
 
-  const rover::eval::ChiSquareInterval bounds =
-      rover::eval::AverageNeesBounds(kNeesDof, options.runs, options.confidence);
+  const rover::stats::ChiSquareInterval bounds =
+      rover::stats::AverageNeesBounds(kNeesDof, options.runs, options.confidence);
   summary.bound_lo = bounds.lower;
   summary.bound_hi = bounds.upper;
   const double n = static_cast<double>(options.runs);

@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "core/config/config.h"
+#include "core/stats/percentile.h"
 #include "estimator/eskf/local_reference_filter.h"
 #include "estimator/eval/csv_trajectory.h"
 #include "estimator/eval/eval_error.h"
@@ -632,8 +633,8 @@ void PrintVoTiming(const VioRun& run, std::ostream& out) {
     std::vector<double> v;
     v.reserve(run.vo_times.size());
     for (const vo::VoStageTimes& t : run.vo_times) v.push_back(t.*stage);
-    table.AddRow({name, Fixed(Percentile(v, 50.0), 2), Fixed(Percentile(v, 99.0), 2),
-                  Fixed(Percentile(v, 100.0), 2)});
+    table.AddRow({name, Fixed(stats::Percentile(v, 50.0), 2), Fixed(stats::Percentile(v, 99.0), 2),
+                  Fixed(stats::Percentile(v, 100.0), 2)});
   };
   row("check", &vo::VoStageTimes::check_ms);
   row("rectify", &vo::VoStageTimes::rectify_ms);
@@ -719,10 +720,10 @@ void PrintDeltaPoseNees(const VioRun& run, std::ostream& out) {
       << n.singular << " with a covariance not positive definite)\n";
   TextTable table(
       {"", "dof", "mean", "95% bounds of the mean", "inside", "samples in 95% interval"});
-  const auto bounds = [](const ev::ChiSquareInterval& b) {
+  const auto bounds = [](const rover::stats::ChiSquareInterval& b) {
     return "[" + Fixed(b.lower, 3) + ", " + Fixed(b.upper, 3) + "]";
   };
-  const auto inside = [](double mean, const ev::ChiSquareInterval& b) {
+  const auto inside = [](double mean, const rover::stats::ChiSquareInterval& b) {
     return std::isnan(mean) ? "-" : (mean >= b.lower && mean <= b.upper ? "yes" : "NO");
   };
   table.AddRow({"pose", "6", Fixed(n.mean_pose, 3), bounds(d.bounds_6dof),
@@ -792,8 +793,8 @@ void PrintVioReport(const VioRun& run, std::ostream& out) {
              {"final_err_pct", General(final_pct)},
              {"rpe_trans_pct", General(run.vo_rpe.translation_pct)},
              {"rpe_rot_deg_per_m", General(run.vo_rpe.rotation_deg_per_m)},
-             {"vo_ms_p50", General(Percentile(total_ms, 50.0))},
-             {"vo_ms_p99", General(Percentile(total_ms, 99.0))},
+             {"vo_ms_p50", General(stats::Percentile(total_ms, 50.0))},
+             {"vo_ms_p99", General(stats::Percentile(total_ms, 99.0))},
          })
       << "\n";
 }

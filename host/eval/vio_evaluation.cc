@@ -27,16 +27,6 @@ Eigen::Isometry3d MeasuredPose(const estimator::RelativePoseMeasurement& m) {
 
 }  // namespace
 
-double Percentile(std::vector<double> values, double p) {
-  if (values.empty()) return kNaN;
-  std::sort(values.begin(), values.end());
-  const double rank = std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(values.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(rank));
-  const std::size_t hi = std::min(lo + 1, values.size() - 1);
-  const double f = rank - static_cast<double>(lo);
-  return values[lo] + f * (values[hi] - values[lo]);
-}
-
 bool VoChain::Add(Time capture, const Eigen::Isometry3d& T_odom_body, bool starts_chain) {
   if (!trajectory_.empty()) {
     const ev::PoseSample& last = trajectory_.samples().back();
@@ -103,8 +93,8 @@ DeltaPoseNees ComputeDeltaPoseNees(
   }
   const int n = static_cast<int>(r.nees.samples.size());
   if (n > 0) {
-    r.bounds_6dof = ev::AverageNeesBounds(6, n, kNeesConfidence);
-    r.bounds_3dof = ev::AverageNeesBounds(3, n, kNeesConfidence);
+    r.bounds_6dof = rover::stats::AverageNeesBounds(6, n, kNeesConfidence);
+    r.bounds_3dof = rover::stats::AverageNeesBounds(3, n, kNeesConfidence);
     r.pose_inside =
         r.nees.mean_pose >= r.bounds_6dof.lower && r.nees.mean_pose <= r.bounds_6dof.upper;
   }

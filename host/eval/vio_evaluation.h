@@ -19,21 +19,17 @@
 #include <string>
 #include <vector>
 
+#include "core/stats/chi_square.h"
 #include "core/time/time.h"
 #include "estimator/eskf/eskf_input.h"
 #include "estimator/eval/alignment.h"
 #include "estimator/eval/association.h"
 #include "estimator/eval/ate.h"
-#include "estimator/eval/chi_square.h"
 #include "estimator/eval/nees.h"
 #include "estimator/eval/rpe.h"
 #include "estimator/eval/trajectory.h"
 
 namespace rover::host::eval {
-
-/// The p-th percentile (0 <= p <= 100) of `values`, interpolated linearly
-/// between the closest ranks (p = 50 is the median). NaN for no values.
-double Percentile(std::vector<double> values, double p);
 
 /// Chains the VO's per-frame poses into one trajectory. The VO's odometry
 /// frame is the body at the first keyframe of a chain; after a tracking loss
@@ -80,10 +76,10 @@ struct DeltaPoseNees {
   double rms_rotation_sigma_deg = std::numeric_limits<double>::quiet_NaN();
   /// Two-sided 95 % bounds of the mean of N = nees.samples.size() NEES
   /// samples: chi2(6 N) / N and chi2(3 N) / N quantiles (NaN without samples).
-  rover::eval::ChiSquareInterval bounds_6dof{std::numeric_limits<double>::quiet_NaN(),
-                                             std::numeric_limits<double>::quiet_NaN()};
-  rover::eval::ChiSquareInterval bounds_3dof{std::numeric_limits<double>::quiet_NaN(),
-                                             std::numeric_limits<double>::quiet_NaN()};
+  rover::stats::ChiSquareInterval bounds_6dof{std::numeric_limits<double>::quiet_NaN(),
+                                              std::numeric_limits<double>::quiet_NaN()};
+  rover::stats::ChiSquareInterval bounds_3dof{std::numeric_limits<double>::quiet_NaN(),
+                                              std::numeric_limits<double>::quiet_NaN()};
   /// The 6-dof mean lies inside bounds_6dof.
   bool pose_inside = false;
 };

@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "core/stats/chi_square.h"
 #include "mapping/graph/chordal_initialisation.h"
 #include "mapping/graph/chordal_pose_2d_cost.h"
 #include "mapping/graph/chordal_pose_3d_cost.h"
@@ -231,35 +232,7 @@ double ChiSquaredQuantile(int dof, double p) {
   if (dof < 1 || !(p > 0.0 && p < 1.0)) {
     throw std::invalid_argument("ChiSquaredQuantile: need dof >= 1 and 0 < p < 1");
   }
-  // Upper tail Q(x) = P(chi2_dof > x) in closed form: even dof,
-  // exp(-x/2) sum_{k < dof/2} (x/2)^k / k!; odd dof,
-  // erfc(sqrt(x/2)) + exp(-x/2) sum_{k=1}^{(dof-1)/2} (x/2)^(k-1/2) / Gamma(k + 1/2).
-  auto upper_tail = [dof](double x) {
-    const double h = 0.5 * x;
-    double sum = 0.0;
-    if (dof % 2 == 0) {
-      double term = 1.0;
-      for (int k = 0; k < dof / 2; ++k) {
-        sum += term;
-        term *= h / (k + 1);
-      }
-      return std::exp(-h) * sum;
-    }
-    double term = std::sqrt(h) / std::tgamma(1.5);
-    for (int k = 1; k <= (dof - 1) / 2; ++k) {
-      sum += term;
-      term *= h / (k + 0.5);
-    }
-    return std::erfc(std::sqrt(h)) + std::exp(-h) * sum;
-  };
-  double lo = 0.0;
-  double hi = 1.0;
-  while (upper_tail(hi) > 1.0 - p) hi *= 2.0;
-  for (int it = 0; it < 200 && hi - lo > 1e-12 * hi; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (upper_tail(mid) > 1.0 - p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  return stats::Chi2Quantile(static_cast<double>(dof), p);
 }
 
 double InlierThreshold(int dimension, double confidence) {

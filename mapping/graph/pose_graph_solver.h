@@ -114,7 +114,7 @@ std::vector<bool> RobustChordalInitialisation(PoseGraph& graph,
                                               int* steps = nullptr);
 
 /// Quantile of the chi-squared distribution with `dof` degrees of freedom:
-/// the x with P(chi2_dof <= x) = p (closed-form CDF, bisection), p in (0, 1).
+/// the x with P(chi2_dof <= x) = p, p in (0, 1) (stats::Chi2Quantile).
 double ChiSquaredQuantile(int dof, double p);
 
 /// Bound on an inlier's F term at confidence p. If the edge noise follows its

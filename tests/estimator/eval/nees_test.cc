@@ -4,7 +4,7 @@
 #include <random>
 
 #include "core/geometry/so3.h"
-#include "estimator/eval/chi_square.h"
+#include "core/stats/chi_square.h"
 #include "estimator/eval/nees.h"
 #include "tests/estimator/eval/eval_test_util.h"
 
@@ -45,8 +45,8 @@ TEST(NeesTest, SamplesFromTheStatedCovarianceAverageTheDof) {
   const int n = 2000;
   const NeesResult r = ComputeNees(DrawSamples(rng, n, Side::kBody));
   ASSERT_EQ(r.samples.size(), static_cast<std::size_t>(n));
-  const ChiSquareInterval three = AverageNeesBounds(3, n);
-  const ChiSquareInterval six = AverageNeesBounds(6, n);
+  const stats::ChiSquareInterval three = stats::AverageNeesBounds(3, n);
+  const stats::ChiSquareInterval six = stats::AverageNeesBounds(6, n);
   EXPECT_GT(r.mean_position, three.lower);
   EXPECT_LT(r.mean_position, three.upper);
   EXPECT_GT(r.mean_attitude, three.lower);
@@ -61,7 +61,7 @@ TEST(NeesTest, AttitudeErrorOnTheWrongSideIsInconsistent) {
   std::mt19937_64 rng(2024);
   const int n = 2000;
   const NeesResult r = ComputeNees(DrawSamples(rng, n, Side::kWorld));
-  EXPECT_GT(r.mean_attitude, AverageNeesBounds(3, n).upper);
+  EXPECT_GT(r.mean_attitude, stats::AverageNeesBounds(3, n).upper);
 }
 
 TEST(NeesTest, ErrorConventionAndSkippedSamples) {

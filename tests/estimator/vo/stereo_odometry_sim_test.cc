@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "core/geometry/so3.h"
+#include "core/stats/chi_square.h"
 #include "drivers/replay/euroc_dataset.h"
-#include "estimator/eval/chi_square.h"
 #include "estimator/vo/stereo_odometry.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/scenario/scenario.h"
@@ -89,8 +89,8 @@ RunFigures RunVo(const drivers::EurocDataset& d) {
   fig.final_rotation_error_rad = LogSO3(last_error.linear()).norm();
   fig.mean_nees = nees_sum / fig.measurements;
   const double dof = 6.0 * fig.measurements;
-  fig.nees_lo = eval::Chi2Quantile(dof, 0.025) / fig.measurements;
-  fig.nees_hi = eval::Chi2Quantile(dof, 0.975) / fig.measurements;
+  fig.nees_lo = rover::stats::Chi2Quantile(dof, 0.025) / fig.measurements;
+  fig.nees_hi = rover::stats::Chi2Quantile(dof, 0.975) / fig.measurements;
   fig.health = vo->health();
   return fig;
 }

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "estimator/eval/chi_square.h"
+#include "core/stats/chi_square.h"
 #include "host/eval/nees_command.h"
 #include "host/eval/sim_command.h"
 #include "host/eval/subcommand.h"
@@ -108,7 +108,7 @@ TEST(RoverEvalNees, AverageNeesOfFourRunsInsideBounds) {
                                               "bound_hi"}))
       << LastLine(r.out);
   EXPECT_EQ(f.values.at("runs"), "4");
-  const rover::eval::ChiSquareInterval bounds = rover::eval::AverageNeesBounds(3, 4, 0.95);
+  const rover::stats::ChiSquareInterval bounds = rover::stats::AverageNeesBounds(3, 4, 0.95);
   EXPECT_NEAR(Number(f, "bound_lo"), bounds.lower, 1e-4);
   EXPECT_NEAR(Number(f, "bound_hi"), bounds.upper, 1e-4);
   const double pos = Number(f, "nees_pos_mean"), att = Number(f, "nees_att_mean");
@@ -258,7 +258,7 @@ TEST(RoverEvalSimCommandLine, NeesAndSimParseTheirOptions) {
     EXPECT_THAT(report, HasSubstr("VO preset realistic, wheels on"));
     const ResultFields f = ParseResult(LastLine(report));
     ASSERT_EQ(f.keys.size(), 5u) << report;
-    EXPECT_NEAR(Number(f, "bound_hi"), rover::eval::AverageNeesBounds(3, 1, 0.9).upper, 1e-4);
+    EXPECT_NEAR(Number(f, "bound_hi"), rover::stats::AverageNeesBounds(3, 1, 0.9).upper, 1e-4);
   }
   {
     CLI::App app;

@@ -64,18 +64,6 @@ std::string WriteFile(const testing::TempDir& dir, const std::string& name,
   return path;
 }
 
-// ------------------------------------------------------------- Percentile
-
-TEST(PercentileTest, InterpolatesBetweenRanks) {
-  EXPECT_DOUBLE_EQ(Percentile({3.0, 1.0, 2.0}, 50.0), 2.0);
-  EXPECT_DOUBLE_EQ(Percentile({0.0, 10.0}, 25.0), 2.5);
-  std::vector<double> v;
-  for (int i = 0; i <= 100; ++i) v.push_back(i);
-  EXPECT_DOUBLE_EQ(Percentile(v, 99.0), 99.0);
-  EXPECT_DOUBLE_EQ(Percentile(v, 100.0), 100.0);
-  EXPECT_TRUE(std::isnan(Percentile({}, 50.0)));
-}
-
 // ---------------------------------------------------------------- VoChain
 
 TEST(VoChainTest, OneChainKeepsTheVoPoses) {
@@ -168,9 +156,9 @@ TEST(DeltaPoseNeesTest, KnownErrorGivesItsNees) {
   EXPECT_NEAR(r.nees.mean_position, 1.0 + 4.0 + 1.0, 1e-6);
   EXPECT_NEAR(r.nees.mean_attitude, 4.0 + 0.0 + 1.0, 1e-6);
   EXPECT_NEAR(r.nees.mean_pose, 11.0, 1e-6);
-  EXPECT_NEAR(r.bounds_6dof.lower, ev::Chi2Quantile(6, 0.025), 1e-9);
-  EXPECT_NEAR(r.bounds_6dof.upper, ev::Chi2Quantile(6, 0.975), 1e-9);
-  EXPECT_NEAR(r.bounds_3dof.upper, ev::Chi2Quantile(3, 0.975), 1e-9);
+  EXPECT_NEAR(r.bounds_6dof.lower, rover::stats::Chi2Quantile(6, 0.025), 1e-9);
+  EXPECT_NEAR(r.bounds_6dof.upper, rover::stats::Chi2Quantile(6, 0.975), 1e-9);
+  EXPECT_NEAR(r.bounds_3dof.upper, rover::stats::Chi2Quantile(3, 0.975), 1e-9);
   EXPECT_TRUE(r.pose_inside);  // 11 < 14.45
 }
 

@@ -1,14 +1,20 @@
-#include "estimator/eval/chi_square.h"
+#include "core/stats/chi_square.h"
 
+#include <charconv>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
-#include "estimator/eval/eval_error.h"
-#include "estimator/eval/number_format.h"
-
-namespace rover::eval {
+namespace rover::stats {
 namespace {
+
+// Shortest text that reads back as `value`, for error messages.
+std::string FormatDouble(double value) {
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof(text), value);
+  return ec == std::errc() ? std::string(text, end) : std::string("?");
+}
 
 constexpr double kEpsilon = 1e-16;
 constexpr int kMaxIterations = 1000;
@@ -61,8 +67,10 @@ double Chi2Pdf(double dof, double x) {
 }  // namespace
 
 double RegularizedGammaP(double a, double x) {
-  if (!(a > 0.0)) throw EvalError("RegularizedGammaP: expected a > 0, found " + FormatDouble(a));
-  if (!(x >= 0.0)) throw EvalError("RegularizedGammaP: expected x >= 0, found " + FormatDouble(x));
+  if (!(a > 0.0))
+    throw std::invalid_argument("RegularizedGammaP: expected a > 0, found " + FormatDouble(a));
+  if (!(x >= 0.0))
+    throw std::invalid_argument("RegularizedGammaP: expected x >= 0, found " + FormatDouble(x));
   if (x == 0.0) return 0.0;
   if (std::isinf(x)) return 1.0;
   if (x < a + 1.0) return GammaPSeries(a, x);
@@ -70,15 +78,17 @@ double RegularizedGammaP(double a, double x) {
 }
 
 double Chi2Cdf(double dof, double x) {
-  if (!(dof > 0.0)) throw EvalError("Chi2Cdf: expected dof > 0, found " + FormatDouble(dof));
+  if (!(dof > 0.0))
+    throw std::invalid_argument("Chi2Cdf: expected dof > 0, found " + FormatDouble(dof));
   if (x <= 0.0) return 0.0;
   return RegularizedGammaP(0.5 * dof, 0.5 * x);
 }
 
 double Chi2Quantile(double dof, double p) {
-  if (!(dof > 0.0)) throw EvalError("Chi2Quantile: expected dof > 0, found " + FormatDouble(dof));
+  if (!(dof > 0.0))
+    throw std::invalid_argument("Chi2Quantile: expected dof > 0, found " + FormatDouble(dof));
   if (!(p >= 0.0 && p <= 1.0)) {
-    throw EvalError("Chi2Quantile: expected p in [0, 1], found " + FormatDouble(p));
+    throw std::invalid_argument("Chi2Quantile: expected p in [0, 1], found " + FormatDouble(p));
   }
   if (p == 0.0) return 0.0;
   if (p == 1.0) return std::numeric_limits<double>::infinity();
@@ -115,13 +125,15 @@ double Chi2Quantile(double dof, double p) {
 
 ChiSquareInterval AverageNeesBounds(int dof, int runs, double confidence) {
   if (dof <= 0)
-    throw EvalError("AverageNeesBounds: expected dof > 0, found " + std::to_string(dof));
+    throw std::invalid_argument("AverageNeesBounds: expected dof > 0, found " +
+                                std::to_string(dof));
   if (runs <= 0) {
-    throw EvalError("AverageNeesBounds: expected runs > 0, found " + std::to_string(runs));
+    throw std::invalid_argument("AverageNeesBounds: expected runs > 0, found " +
+                                std::to_string(runs));
   }
   if (!(confidence > 0.0 && confidence < 1.0)) {
-    throw EvalError("AverageNeesBounds: expected a confidence in (0, 1), found " +
-                    FormatDouble(confidence));
+    throw std::invalid_argument("AverageNeesBounds: expected a confidence in (0, 1), found " +
+                                FormatDouble(confidence));
   }
   const double total_dof = static_cast<double>(dof) * static_cast<double>(runs);
   const double n = static_cast<double>(runs);
@@ -129,4 +141,4 @@ ChiSquareInterval AverageNeesBounds(int dof, int runs, double confidence) {
           Chi2Quantile(total_dof, 0.5 * (1.0 + confidence)) / n};
 }
 
-}  // namespace rover::eval
+}  // namespace rover::stats
