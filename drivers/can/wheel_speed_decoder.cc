@@ -53,4 +53,13 @@ uint8_t WheelSpeedDecoder::MissingDrives(Time now) const {
   return missing;
 }
 
+std::vector<WheelSpeeds> DecodeWheelSpeeds(const std::vector<CanFrame>& frames) {
+  std::vector<WheelSpeeds> out;
+  WheelSpeedDecoder decoder;
+  for (const CanFrame& f : frames) {
+    if (const std::optional<WheelSpeeds> speeds = decoder.Feed(f)) out.push_back(*speeds);
+  }
+  return out;
+}
+
 }  // namespace rover::drivers

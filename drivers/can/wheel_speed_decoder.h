@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "core/time/time.h"
 #include "drivers/can/can_frame.h"
@@ -58,6 +59,11 @@ class WheelSpeedDecoder {
   std::array<std::optional<Time>, 4> last_heartbeat_;
   WheelSpeedDecoderStats stats_;
 };
+
+/// Decodes a whole recorded frame stream (in receive order) into the wheel
+/// speeds of its complete SYNC periods, as a live decoder would have emitted
+/// them; other frames (heartbeats) are ignored.
+std::vector<WheelSpeeds> DecodeWheelSpeeds(const std::vector<CanFrame>& frames);
 
 }  // namespace rover::drivers
 

@@ -10,7 +10,6 @@
 #include <opencv2/core.hpp>
 
 #include "core/log/msgs/message_traits.h"
-#include "estimator/eskf/eskf_output.h"
 #include "firmware/mapd/submap_archive.h"
 
 namespace rover::mapd {
@@ -212,7 +211,7 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
   history_.Add(PoseOf(pose));
   // Before the filter has initialised there is no frame to map in, and it
   // would refuse a switch.
-  if ((pose.status & estimator::kStatusNotInitialised) != 0) return;
+  if ((pose.status & topics::kPoseStatusNotInitialised) != 0) return;
   const Time stamp = Time::FromNanoseconds(pose.stamp_ns);
   const Eigen::Vector3d p(pose.p_local_body_m[0], pose.p_local_body_m[1], pose.p_local_body_m[2]);
   const std::optional<topics::SwitchReason> reason =

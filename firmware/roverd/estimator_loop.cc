@@ -12,25 +12,6 @@ namespace {
 
 namespace msgs = log::rover_msgs;
 
-// Tie-break at equal stamps: triggers first (a clone must exist before a
-// measurement refers to it), then wheels, VO, requests.
-int Rank(const estimator::EskfInput& input) {
-  return std::visit(
-      [](const auto& m) {
-        using T = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<T, estimator::CloneTrigger>) return 0;
-        if constexpr (std::is_same_v<T, estimator::WheelSpeedMeasurement>) return 1;
-        if constexpr (std::is_same_v<T, estimator::RelativePoseMeasurement>) return 2;
-        return 3;
-      },
-      input);
-}
-
-bool Before(const estimator::EskfInput& a, const estimator::EskfInput& b) {
-  const Time ta = estimator::StampOf(a), tb = estimator::StampOf(b);
-  return ta < tb || (ta == tb && Rank(a) < Rank(b));
-}
-
 // "local/rover/<id>" without allocating.
 log::FrameId LocalFrameName(uint32_t frame_id) {
   char text[32];
@@ -99,24 +80,15 @@ bool EstimatorLoop::PushFrameSwitchRequest(const estimator::FrameSwitchRequest& 
 }
 
 void EstimatorLoop::Collect() {
-  // Insertion into the sorted merge buffer: no allocation, and the buffer is small.
-  const auto insert = [this](const estimator::EskfInput& input) {
-    std::size_t i = pending_count_;
-    while (i > 0 && Before(input, pending_[i - 1])) {
-      pending_[i] = pending_[i - 1];
-      --i;
+  // A ring's head that does not fit waits in the ring for the next Step().
+  const auto drain = [this](auto& ring) {
+    for (const auto* item = ring.Front(); item != nullptr; item = ring.Front()) {
+      if (!merger_.Push(estimator::EskfInput(*item))) {
+        pending_full_.fetch_add(1, std::memory_order_relaxed);
+        return;
+      }
+      ring.PopFront();
     }
-    pending_[i] = input;
-    ++pending_count_;
-  };
-  const auto drain = [&](auto& ring) {
-    using T = typename std::remove_reference_t<decltype(ring)>::value_type;
-    T item;
-    while (pending_count_ < kMergeSlots) {
-      if (!ring.TryPop(&item)) return;
-      insert(estimator::EskfInput(item));
-    }
-    if (!ring.empty()) pending_full_.fetch_add(1, std::memory_order_relaxed);
   };
   drain(clone_triggers_);
   drain(wheel_speeds_);
@@ -127,24 +99,13 @@ void EstimatorLoop::Collect() {
 void EstimatorLoop::Step(const estimator::ImuMeasurement& imu) {
   if (lockstep_) WaitForLogRoom();
   Collect();
-  std::size_t fed = 0;
-  while (fed < pending_count_ && !(imu.stamp < estimator::StampOf(pending_[fed]))) {
-    if (estimator::StampOf(pending_[fed]) < last_imu_stamp_) {
-      late_inputs_.fetch_add(1, std::memory_order_relaxed);
-    }
-    Feed(pending_[fed]);
-    ++fed;
-  }
-  for (std::size_t i = fed; i < pending_count_; ++i) pending_[i - fed] = pending_[i];
-  pending_count_ -= fed;
-  Feed(estimator::EskfInput(imu));
-  last_imu_stamp_ = imu.stamp;
+  merger_.Step(imu, [this](const estimator::EskfInput& input) { Feed(input); });
+  late_inputs_.store(merger_.late_inputs(), std::memory_order_relaxed);
 }
 
 void EstimatorLoop::Drain() {
   Collect();
-  for (std::size_t i = 0; i < pending_count_; ++i) Feed(pending_[i]);
-  pending_count_ = 0;
+  merger_.Drain([this](const estimator::EskfInput& input) { Feed(input); });
 }
 
 void EstimatorLoop::Feed(const estimator::EskfInput& input) {

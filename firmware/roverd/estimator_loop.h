@@ -33,6 +33,7 @@
 #include "estimator/eskf/eskf_options.h"
 #include "estimator/eskf/eskf_output.h"
 #include "estimator/eskf/local_reference_filter.h"
+#include "estimator/feed/input_merger.h"
 #include "estimator/io/estimator_log_records.h"
 
 namespace rover::roverd {
@@ -133,10 +134,8 @@ class EstimatorLoop final : private estimator::EskfOutputSink {
   SpscRing<estimator::CloneTrigger, kRingSlots> clone_triggers_;
   SpscRing<estimator::FrameSwitchRequest, kRingSlots> requests_;
 
-  std::array<estimator::EskfInput, kMergeSlots> pending_;
-  std::size_t pending_count_ = 0;
+  estimator::InputMerger<kMergeSlots> merger_;
   uint64_t current_sequence_ = 0;  ///< of the input being fed (outputs carry it)
-  Time last_imu_stamp_;
 
   std::atomic<uint64_t> inputs_{0};
   std::atomic<uint64_t> states_{0};

@@ -86,6 +86,9 @@ MapdLink::MapdLink(ipc::Transport* transport,
   }
 }
 
+static_assert(topics::kPoseStatusNotInitialised == estimator::kStatusNotInitialised,
+              "PoseMsg::status carries the filter's status bits unchanged");
+
 void MapdLink::OnState(const estimator::EskfOutput& o) {
   latest_stamp_ns_.store(o.stamp.nanoseconds(), std::memory_order_relaxed);
   poses_->PublishInPlace([&o](topics::PoseMsg& m) {

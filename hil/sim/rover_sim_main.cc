@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <iostream>
 #include <map>
+#include <vector>
 
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,9 @@
 #include "drivers/can/socket_can_bus.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/devices/simulated_mti.h"
+#include "hil/sim/experiments/map_command.h"
+#include "hil/sim/experiments/nees_command.h"
+#include "hil/sim/experiments/filter_command.h"
 #include "hil/sim/imu_mission.h"
 #include "hil/sim/live/sim_can_bus.h"
 #include "hil/sim/scenario/scenario.h"
@@ -201,7 +205,10 @@ int RunMti(const MtiArgs& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "rover-sim: simulated rover sensors for software-in-the-loop runs.\n"
+      "rover-sim: simulated rover sensors for software-in-the-loop runs, and the experiments\n"
+      "that score the software against the simulator's ground truth (filter: the local\n"
+      "reference filter's accuracy, nees: its Monte Carlo consistency, map: a simulated\n"
+      "mission's map).\n"
       "Sensor streams go through the same real-time flight-log path as on the rover."};
   app.require_subcommand(1);
 
@@ -280,8 +287,19 @@ int main(int argc, char** argv) {
   mti->add_option("--wait-s", mti_args.wait_s, "give up when no driver configures it this long")
       ->capture_default_str();
 
+  // The experiments, one line each (hil/sim/experiments/*_command.{h,cc}).
+  namespace experiments = rover::sim::experiments;
+  const std::vector<rover::cli::Subcommand> experiment_commands = {
+      experiments::AddFilterCommand(app),
+      experiments::AddNeesCommand(app),
+      experiments::AddMapCommand(app),
+  };
+
   CLI11_PARSE(app, argc, argv);
 
+  for (const rover::cli::Subcommand& s : experiment_commands) {
+    if (s.app->parsed()) return s.run();
+  }
   try {
     if (*mti) return RunMti(mti_args);
     if (*can) return RunCan(can_args);

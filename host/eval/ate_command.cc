@@ -9,9 +9,17 @@
 #include "core/stats/chi_square.h"
 #include "estimator/eval/eval_error.h"
 #include "estimator/eval/tum_trajectory.h"
-#include "host/eval/report_format.h"
+#include "core/cli/report_format.h"
 
 namespace rover::host::eval {
+
+using cli::Fixed;
+using cli::General;
+using cli::TextTable;
+using cli::ResultLine;
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitBadInput;
 namespace {
 
 namespace ev = rover::eval;

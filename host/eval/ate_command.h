@@ -9,9 +9,13 @@
 
 #include "estimator/eval/trajectory_evaluation.h"
 #include "estimator/eval/trajectory_io.h"
-#include "host/eval/subcommand.h"
+#include "core/cli/subcommand.h"
 
 namespace rover::host::eval {
+
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitBadInput;
 
 struct AteCommandOptions {
   std::string estimate_path;

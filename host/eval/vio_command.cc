@@ -24,9 +24,18 @@
 #include "hil/sim/motion/rover_trajectory.h"
 #include "hil/sim/scenario/scenario.h"
 #include "hil/sim/sensors/wheel_odometry_model.h"
-#include "host/eval/report_format.h"
+#include "core/cli/report_format.h"
 
 namespace rover::host::eval {
+
+using cli::Fixed;
+using cli::General;
+using cli::TextTable;
+using cli::ResultLine;
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitCheckFailed;
+using cli::kExitBadInput;
 namespace {
 
 namespace ev = rover::eval;
@@ -468,7 +477,9 @@ VioRun RunVioExperiment(const VioCommandOptions& options, std::ostream& err) {
   } else if (!fs::exists(can_path)) {
     run.notes.push_back("wheels: none (the dataset has no mav0/can0/data.csv)");
   } else {
-    wheel_speeds = sim::DecodeWheelSpeeds(ReadCanFramesCsv(can_path));
+    for (const drivers::WheelSpeeds& w : drivers::DecodeWheelSpeeds(ReadCanFramesCsv(can_path))) {
+      wheel_speeds.push_back({w.stamp, w.wheel_rate_rad_s});
+    }
     geometry = LoadSimWheelGeometry(options.sim_config_dir.empty() ? sim::DefaultSimConfigDir()
                                                                    : options.sim_config_dir);
     run.notes.push_back("wheels: " + std::to_string(wheel_speeds.size()) +

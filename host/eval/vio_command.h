@@ -32,10 +32,15 @@
 #include "estimator/eskf/eskf_options.h"
 #include "estimator/eval/trajectory_evaluation.h"
 #include "estimator/vo/stereo_odometry.h"
-#include "host/eval/subcommand.h"
+#include "core/cli/subcommand.h"
 #include "host/eval/vio_evaluation.h"
 
 namespace rover::host::eval {
+
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitCheckFailed;
+using cli::kExitBadInput;
 
 struct VioCommandOptions {
   std::string dataset_dir;          ///< the folder holding mav0/

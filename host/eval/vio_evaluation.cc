@@ -7,9 +7,12 @@
 
 #include "core/geometry/so3.h"
 #include "core/geometry/yaw.h"
-#include "host/eval/report_format.h"
+#include "core/cli/report_format.h"
 
 namespace rover::host::eval {
+
+using cli::Fixed;
+using cli::General;
 namespace {
 
 namespace ev = rover::eval;

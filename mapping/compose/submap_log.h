@@ -2,7 +2,7 @@
 #define ROVER_MAPPING_COMPOSE_SUBMAP_LOG_H_
 
 // Reading maps back out of flight logs, for the host tools (rover-log map,
-// rover-eval map): the submaps mapd logged (rover_msgs/SubmapInfo with its
+// rover-sim map): the submaps mapd logged (rover_msgs/SubmapInfo with its
 // octomap_msgs/Octomap and sensor_msgs/PointCloud2, matched by header), and
 // the filter's frame switches from roverd's log, chained into each local
 // frame's origin in frame 0. roverd's log has every switch even when mapd

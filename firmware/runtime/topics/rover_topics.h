@@ -35,6 +35,11 @@ inline constexpr std::string_view kDiagnosticsTopic = "/roverd/diagnostics";
 inline constexpr std::string_view kStereoCalibrationTopic = "/roverd/stereo_calibration";
 inline constexpr std::string_view kTraversabilityTopic = "/mapd/traversability";
 
+/// PoseMsg::status bit: the filter is not initialised yet (the same bit as
+/// estimator::kStatusNotInitialised, checked where roverd fills the message),
+/// so readers need not link the estimator.
+inline constexpr uint32_t kPoseStatusNotInitialised = 1u << 0;
+
 /// One estimate of the local reference filter, in its current local frame.
 struct PoseMsg {
   uint32_t version = kTopicsVersion;

@@ -8,6 +8,7 @@
 
 #include "drivers/can/canopen_wheel_protocol.h"
 #include "drivers/can/wheel_speed_decoder.h"
+#include "estimator/feed/input_order.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/sensors/gpio_edge_model.h"
 #include "hil/sim/sensors/imu_model.h"
@@ -15,19 +16,6 @@
 
 namespace rover::sim {
 namespace {
-
-// Rank of each input kind at equal stamps (IMU first).
-constexpr int kRankImu = 0;
-constexpr int kRankWheels = 1;
-constexpr int kRankTrigger = 2;
-constexpr int kRankRelativePose = 3;
-constexpr int kRankFrameSwitch = 4;
-
-struct Keyed {
-  Time stamp;
-  int rank = 0;
-  estimator::EskfInput input;
-};
 
 TruthSample TruthOf(Time stamp, const TrajectorySample& s) {
   TruthSample t;
@@ -60,17 +48,6 @@ void FilterFeedOptions::Validate() const {
   vo.Validate();
 }
 
-std::vector<estimator::WheelSpeedMeasurement> DecodeWheelSpeeds(
-    const std::vector<drivers::CanFrame>& frames) {
-  std::vector<estimator::WheelSpeedMeasurement> out;
-  drivers::WheelSpeedDecoder decoder;
-  for (const drivers::CanFrame& f : frames) {
-    if (const auto speeds = decoder.Feed(f))
-      out.push_back({speeds->stamp, speeds->wheel_rate_rad_s});
-  }
-  return out;
-}
-
 FilterFeed::FilterFeed(FilterFeed&&) noexcept = default;
 FilterFeed& FilterFeed::operator=(FilterFeed&&) noexcept = default;
 FilterFeed::~FilterFeed() = default;
@@ -91,7 +68,6 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
                                 : trajectory.duration_s();
   end_ = start_ + Duration::FromSeconds(duration_s);
 
-  std::vector<Keyed> keyed;
 
   // IMU samples, their truth and the driven distance (for frame switches).
   ImuModelOptions imu_options = scenario.imu;
@@ -107,7 +83,7 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
     m.stamp = sample.stamp;
     m.angular_velocity_rad_s = sample.angular_velocity_rad_s;
     m.linear_acceleration_m_s2 = sample.linear_acceleration_m_s2;
-    keyed.push_back({m.stamp, kRankImu, m});
+    inputs_.push_back(m);
     TruthSample t = TruthOf(sample.stamp, truth);
     t.gyro_bias_rad_s = imu.gyro_bias_rad_s();
     t.accel_bias_m_s2 = imu.accel_bias_m_s2();
@@ -116,7 +92,7 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
     distance_m_ += (truth.p_world_body.head<2>() - last_xy).norm();
     last_xy = truth.p_world_body.head<2>();
     if (options_.frame_switch_distance_m > 0.0 && distance_m_ >= next_switch_m) {
-      keyed.push_back({m.stamp, kRankFrameSwitch, estimator::FrameSwitchRequest{m.stamp}});
+      inputs_.push_back(estimator::FrameSwitchRequest{m.stamp});
       ++counts_.frame_switches;
       while (next_switch_m <= distance_m_) next_switch_m += options_.frame_switch_distance_m;
     }
@@ -127,8 +103,8 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
   std::vector<drivers::CanFrame> frames;
   wheels.Advance(end_, &frames, &wheel_truth_);
   if (options_.wheels_enabled) {
-    for (const estimator::WheelSpeedMeasurement& w : DecodeWheelSpeeds(frames)) {
-      keyed.push_back({w.stamp, kRankWheels, w});
+    for (const drivers::WheelSpeeds& w : drivers::DecodeWheelSpeeds(frames)) {
+      inputs_.push_back(estimator::WheelSpeedMeasurement{w.stamp, w.wheel_rate_rad_s});
       ++counts_.wheel_speeds;
     }
   }
@@ -137,7 +113,7 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
   const GpioEdgeModel gpio(scenario.gpio, start_);
   std::vector<VoFrame> vo_frames;
   for (const Time t : gpio.CameraTriggerTimes(start_, end_)) {
-    keyed.push_back({t, kRankTrigger, estimator::CloneTrigger{t}});
+    inputs_.push_back(estimator::CloneTrigger{t});
     ++counts_.clone_triggers;
     const TruthSample truth = TruthAt(t);
     trigger_truth_.push_back(truth);
@@ -150,15 +126,12 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
        RunSyntheticVo(options_.vo, vo_frames, seed, &counts_.vo)) {
     // A measurement delivered after the end of the feed is never seen.
     if (m.stamp >= end_) continue;
-    keyed.push_back({m.stamp, kRankRelativePose, m});
+    inputs_.push_back(m);
     ++counts_.relative_poses;
   }
 
-  std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
-    return a.stamp != b.stamp ? a.stamp < b.stamp : a.rank < b.rank;
-  });
-  inputs_.reserve(keyed.size());
-  for (Keyed& k : keyed) inputs_.push_back(std::move(k.input));
+  // The filter's one input order (estimator/feed), as roverd merges it.
+  estimator::SortInputs(&inputs_);
 }
 
 TruthSample FilterFeed::TruthAt(Time t) const {

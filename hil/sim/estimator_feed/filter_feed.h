@@ -14,8 +14,8 @@
 // kDatasetStartTime), so a feed and a dataset of the same scenario and seed
 // carry the same samples.
 //
-// Merge order: by stamp; at equal stamps IMU first, then wheel speeds, clone
-// triggers, relative poses and frame switches, each kind in its own order.
+// Merge order: the filter's one input order (estimator/feed/input_order.h),
+// as roverd's IMU thread merges them.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -118,13 +118,6 @@ class FilterFeed {
   FilterFeedCounts counts_;
   double distance_m_ = 0.0;
 };
-
-/// Decodes a CAN frame stream (SYNC, then the four TPDO1s of nodes 1..4) into
-/// wheel speeds stamped at their SYNC, in wheel order FL, FR, RL, RR. A SYNC
-/// period missing any of the four TPDO1s yields nothing; other frames
-/// (heartbeats) are ignored.
-std::vector<estimator::WheelSpeedMeasurement> DecodeWheelSpeeds(
-    const std::vector<drivers::CanFrame>& frames);
 
 }  // namespace rover::sim
 

@@ -2,7 +2,7 @@
 // one already runs), mapd and roverd-sim, restarts mapd whenever it dies
 // (as systemd does on a board: Restart=always), and when roverd-sim is done
 // stops mapd and the RouDi it started. With --evaluate-map it then scores
-// the mission's map against the simulator's ground truth (rover-eval map)
+// the mission's map against the simulator's ground truth (rover-sim map)
 // and ends with roverd-sim's RESULT line extended by the map's fields.
 // Exits with roverd-sim's status.
 
@@ -26,7 +26,7 @@
 #include "core/ipc/iceoryx_transport.h"
 #include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/process/child_process.h"
-#include "host/eval/map_command.h"
+#include "hil/sim/experiments/map_command.h"
 
 namespace {
 
@@ -53,7 +53,7 @@ std::string ResultField(const std::string& line, const std::string& key) {
 void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
                  const std::vector<int>& mapd_pids) {
   std::string line = roverd_result.substr(0, roverd_result.find('\n'));
-  rover::host::eval::MapCommandOptions options;
+  rover::sim::experiments::MapCommandOptions options;
   options.mission_log = ResultField(line, "log");
   for (const auto& entry : fs::directory_iterator(map_dir)) {
     const std::string name = entry.path().filename().string();
@@ -70,9 +70,9 @@ void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
     if (options.mission_log.empty()) throw std::runtime_error("roverd-sim gave no log= field");
     if (options.mapd_logs.empty())
       throw std::runtime_error("mapd wrote no log in " + map_dir.string());
-    std::cout << "map (rover-eval map " << options.mission_log << "):\n";
-    const rover::host::eval::MapResult r = rover::host::eval::EvaluateMission(options, std::cout);
-    std::cout << line << " " << rover::host::eval::MapResultFields(r) << "\n";
+    std::cout << "map (rover-sim map " << options.mission_log << "):\n";
+    const rover::sim::experiments::MapResult r = rover::sim::experiments::EvaluateMission(options, std::cout);
+    std::cout << line << " " << rover::sim::experiments::MapResultFields(r) << "\n";
   } catch (const std::exception& e) {
     Say("map evaluation: " + std::string(e.what()));
     std::cout << line

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "drivers/can/canopen_wheel_protocol.h"
 
 namespace rover::drivers {
@@ -61,6 +63,28 @@ TEST(WheelSpeedDecoderTest, DriveWithoutHeartbeatIsReportedMissing) {
     d.Feed(EncodeHeartbeat(Ms(1100), {node, kNmtOperational}));
   EXPECT_EQ(d.MissingDrives(Ms(2700)), 0b1000);  // drive 4 silent for 2.6 s
   EXPECT_EQ(d.stats().heartbeats, 7u);
+}
+
+TEST(DecodeWheelSpeedsTest, NeedsAllFourDrivesAndIgnoresHeartbeats) {
+  const Time t = Time::FromSeconds(10.0);
+  std::vector<CanFrame> frames;
+  frames.push_back(EncodeSync(t));
+  for (uint8_t node = 1; node <= 4; ++node) {
+    frames.push_back(EncodeWheelTpdo1(t + Duration::Microseconds(200 * node),
+                                               {node, 1000 * node - 2500, 7}));
+  }
+  frames.push_back(
+      EncodeHeartbeat(t + Duration::Milliseconds(2), {2, kNmtOperational}));
+  const Time t2 = t + Duration::Milliseconds(10);
+  frames.push_back(EncodeSync(t2));
+  frames.push_back(EncodeWheelTpdo1(t2 + Duration::Microseconds(200), {1, 5, 0}));
+  const auto out = DecodeWheelSpeeds(frames);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].stamp, t);
+  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[0], -1.5);
+  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[1], -0.5);
+  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[2], 0.5);
+  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[3], 1.5);
 }
 
 }  // namespace

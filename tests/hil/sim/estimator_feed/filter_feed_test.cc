@@ -251,28 +251,6 @@ TEST(FilterFeedTest, WheelSpeedsDecodedFromCanMatchTheModel) {
   EXPECT_TRUE(turned);
 }
 
-TEST(FilterFeedTest, DecoderNeedsAllFourDrivesAndIgnoresHeartbeats) {
-  const Time t = Time::FromSeconds(10.0);
-  std::vector<drivers::CanFrame> frames;
-  frames.push_back(drivers::EncodeSync(t));
-  for (uint8_t node = 1; node <= 4; ++node) {
-    frames.push_back(drivers::EncodeWheelTpdo1(t + Duration::Microseconds(200 * node),
-                                               {node, 1000 * node - 2500, 7}));
-  }
-  frames.push_back(
-      drivers::EncodeHeartbeat(t + Duration::Milliseconds(2), {2, drivers::kNmtOperational}));
-  const Time t2 = t + Duration::Milliseconds(10);
-  frames.push_back(drivers::EncodeSync(t2));
-  frames.push_back(drivers::EncodeWheelTpdo1(t2 + Duration::Microseconds(200), {1, 5, 0}));
-  const auto out = DecodeWheelSpeeds(frames);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].stamp, t);
-  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[0], -1.5);
-  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[1], -0.5);
-  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[2], 0.5);
-  EXPECT_DOUBLE_EQ(out[0].wheel_rate_rad_s[3], 1.5);
-}
-
 TEST(FilterFeedTest, OptionsSwitchWheelsOffAndRequestFrameSwitches) {
   FilterFeedOptions o;
   o.wheels_enabled = false;

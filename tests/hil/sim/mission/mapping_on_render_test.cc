@@ -1,7 +1,7 @@
 // mapd's per-image pipeline (firmware/mapd LocalMapper) on the simulator's
 // rendered stereo pairs, scored against the world's ground truth: the depth
 // points lie on the true terrain, and the obstacle flags sit on true
-// obstacles. The single-image part of what `rover-eval map` measures on
+// obstacles. The single-image part of what `rover-sim map` measures on
 // whole missions.
 
 #include <gtest/gtest.h>
@@ -184,7 +184,7 @@ TEST_F(MappingOnRenderTest, ObstacleFlagsSitOnTrueObstaclesAndFindThem) {
   // One image sees these rocks only at 3.3-4.4 m, at the far end of stereo
   // range, where the error-adaptive threshold is high and the ground around
   // them sparse (measured: 0.83); the mission's map sees them again closer
-  // (rover-eval map scores that).
+  // (rover-sim map scores that).
   EXPECT_GT(static_cast<double>(truth_found) / truth_seen, 0.75);
 }
 

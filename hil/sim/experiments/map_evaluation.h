@@ -1,5 +1,5 @@
-#ifndef ROVER_HOST_EVAL_MAP_EVALUATION_H_
-#define ROVER_HOST_EVAL_MAP_EVALUATION_H_
+#ifndef ROVER_HIL_SIM_EXPERIMENTS_MAP_EVALUATION_H_
+#define ROVER_HIL_SIM_EXPERIMENTS_MAP_EVALUATION_H_
 
 // Quality of a composed map against the simulator's ground truth.
 //
@@ -40,7 +40,7 @@
 #include "hil/sim/world/world.h"
 #include "mapping/submap/cloud_point.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
 
 struct MapQualityOptions {
   double surface_tolerance_m = 0.1;
@@ -76,6 +76,6 @@ MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
                        const std::vector<Eigen::Isometry3d>& T_world_cameras,
                        const MapQualityOptions& options = {});
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments
 
-#endif  // ROVER_HOST_EVAL_MAP_EVALUATION_H_
+#endif  // ROVER_HIL_SIM_EXPERIMENTS_MAP_EVALUATION_H_

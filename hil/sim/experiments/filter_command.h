@@ -1,10 +1,10 @@
-#ifndef ROVER_HOST_EVAL_SIM_COMMAND_H_
-#define ROVER_HOST_EVAL_SIM_COMMAND_H_
+#ifndef ROVER_HIL_SIM_EXPERIMENTS_FILTER_COMMAND_H_
+#define ROVER_HIL_SIM_EXPERIMENTS_FILTER_COMMAND_H_
 
-// `rover-eval sim`: the local reference filter alone on a simulated scenario
+// `rover-sim filter`: the local reference filter alone on a simulated scenario
 // (hil/sim/estimator_feed: FilterFeed + RunFilter), scored against the
 // simulator's ground truth: ATE, RPE, drift as % of distance, attitude error,
-// NEES, rejections. Also the pieces `rover-eval nees` shares with it: the
+// NEES, rejections. Also the pieces `rover-sim nees` shares with it: the
 // simulation setup, the seed derivation and the parallel run loop.
 //
 // Seeds. Run i (0-based) of a command with --seed S uses the run seed S + i,
@@ -29,9 +29,14 @@
 #include "hil/sim/estimator_feed/filter_feed.h"
 #include "hil/sim/estimator_feed/filter_run.h"
 #include "hil/sim/scenario/scenario.h"
-#include "host/eval/subcommand.h"
+#include "core/cli/subcommand.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
+
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitCheckFailed;
+using cli::kExitBadInput;
 
 /// What to simulate and how to configure the filter (shared by sim and nees).
 struct SimSetup {
@@ -103,7 +108,7 @@ struct SimTrajectories {
 SimTrajectories BuildSimTrajectories(const sim::FilterFeed& feed,
                                      const sim::FilterRunResult& result, double step_s = 0.1);
 
-struct SimCommandOptions {
+struct FilterCommandOptions {
   SimSetup setup;
   uint64_t seed = 1;
   int runs = 1;
@@ -130,11 +135,11 @@ struct SimCommandOptions {
 /// that cannot be computed). Progress goes to `err`. Returns kExitOk;
 /// kExitCheckFailed (after the report) if the filter never initialised in
 /// some run; kExitBadInput (message on `err`) for bad options or scenarios.
-int RunSim(const SimCommandOptions& options, std::ostream& out, std::ostream& err);
+int RunFilterCommand(const FilterCommandOptions& options, std::ostream& out, std::ostream& err);
 
-/// Adds `rover-eval sim` to `app` (see subcommand.h).
-Subcommand AddSimCommand(CLI::App& app);
+/// Adds `rover-sim filter` to `app` (see subcommand.h).
+Subcommand AddFilterCommand(CLI::App& app);
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments
 
-#endif  // ROVER_HOST_EVAL_SIM_COMMAND_H_
+#endif  // ROVER_HIL_SIM_EXPERIMENTS_FILTER_COMMAND_H_

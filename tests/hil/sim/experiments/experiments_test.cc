@@ -1,5 +1,5 @@
-// rover-eval nees and sim: the filter on the simulator (issue 4, "Quality" and
-// "Command-line contract"). Each test runs a few simulations of the `short`
+// rover-sim filter and nees: the filter on the simulator (accuracy; Monte
+// Carlo consistency; the command-line contract). Each test runs a few simulations of the `short`
 // scenario (about 2.5 s each in the dev build, mostly world generation).
 
 #include <gmock/gmock.h>
@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "core/stats/chi_square.h"
-#include "host/eval/nees_command.h"
-#include "host/eval/sim_command.h"
-#include "host/eval/subcommand.h"
+#include "hil/sim/experiments/nees_command.h"
+#include "hil/sim/experiments/filter_command.h"
+#include "core/cli/subcommand.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
 namespace {
 
 using ::testing::HasSubstr;
@@ -78,10 +78,10 @@ Report Nees(const NeesCommandOptions& options) {
   return r;
 }
 
-Report Sim(const SimCommandOptions& options) {
+Report Sim(const FilterCommandOptions& options) {
   std::ostringstream out, err;
   Report r;
-  r.status = RunSim(options, out, err);
+  r.status = RunFilterCommand(options, out, err);
   r.out = out.str();
   r.err = err.str();
   return r;
@@ -158,7 +158,7 @@ TEST(RoverEvalNees, BadOptions) {
   options.setup.scenario = "no-such-scenario";
   Report r = Nees(options);
   EXPECT_EQ(r.status, kExitBadInput);
-  EXPECT_THAT(r.err, HasSubstr("rover-eval nees: "));
+  EXPECT_THAT(r.err, HasSubstr("rover-sim nees: "));
   options = SmallNees(2);
   options.confidence = 1.5;
   r = Nees(options);
@@ -168,7 +168,7 @@ TEST(RoverEvalNees, BadOptions) {
 
 // The sim RESULT line: every field, in order, parseable; plausible values.
 TEST(RoverEvalSim, ResultLineOfShort) {
-  SimCommandOptions options;
+  FilterCommandOptions options;
   options.setup.scenario = "short";
   options.seed = 1;
   const Report r = Sim(options);
@@ -202,7 +202,7 @@ TEST(RoverEvalSim, ResultLineOfShort) {
 // Several runs: the means, identical with one or two threads; a route too
 // short for every RPE segment gives "nan", never a missing field.
 TEST(RoverEvalSim, SeveralRunsDeterministicAndNanForMissingRpe) {
-  SimCommandOptions options;
+  FilterCommandOptions options;
   options.setup.scenario = "short";
   options.setup.max_duration_s = 15.0;
   options.setup.wheels = false;
@@ -224,11 +224,11 @@ TEST(RoverEvalSim, SeveralRunsDeterministicAndNanForMissingRpe) {
 }
 
 TEST(RoverEvalSim, UnknownScenarioIsBadInput) {
-  SimCommandOptions options;
+  FilterCommandOptions options;
   options.setup.scenario = "no-such-scenario";
   const Report r = Sim(options);
   EXPECT_EQ(r.status, kExitBadInput);
-  EXPECT_THAT(r.err, HasSubstr("rover-eval sim: "));
+  EXPECT_THAT(r.err, HasSubstr("rover-sim filter: "));
 }
 
 // The command lines: options reach the runs, bad values are parse errors.
@@ -240,7 +240,7 @@ TEST(RoverEvalSimCommandLine, NeesAndSimParseTheirOptions) {
   }
   {
     CLI::App app;
-    AddSimCommand(app);
+    AddFilterCommand(app);
     EXPECT_THROW(app.parse("sim --wheels maybe"), CLI::ValidationError);
   }
   {
@@ -262,7 +262,7 @@ TEST(RoverEvalSimCommandLine, NeesAndSimParseTheirOptions) {
   }
   {
     CLI::App app;
-    const Subcommand sim = AddSimCommand(app);
+    const Subcommand sim = AddFilterCommand(app);
     app.parse("sim --scenario short --seed 2 --duration-s 5 --wheels off --segments 1,2");
     ASSERT_TRUE(sim.app->parsed());
     ::testing::internal::CaptureStdout();
@@ -276,4 +276,4 @@ TEST(RoverEvalSimCommandLine, NeesAndSimParseTheirOptions) {
 }
 
 }  // namespace
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments

@@ -1,4 +1,4 @@
-#include "host/eval/nees_command.h"
+#include "hil/sim/experiments/nees_command.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,9 +11,18 @@
 
 #include "core/stats/chi_square.h"
 #include "estimator/eval/eval_error.h"
-#include "host/eval/report_format.h"
+#include "core/cli/report_format.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
+
+using cli::Fixed;
+using cli::General;
+using cli::TextTable;
+using cli::ResultLine;
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitCheckFailed;
+using cli::kExitBadInput;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -84,7 +93,7 @@ NeesSummary RunNeesExperiment(const NeesCommandOptions& options, std::ostream& e
   NeesSummary summary;
   summary.runs.resize(static_cast<std::size_t>(options.runs));
   RunInParallel(
-      options.runs, options.jobs, "rover-eval nees",
+      options.runs, options.jobs, "rover-sim nees",
       [&](int i) {
         NeesRun& run = summary.runs[static_cast<std::size_t>(i)];
         run = RunOne(scenario, options, i);
@@ -148,12 +157,12 @@ int RunNees(const NeesCommandOptions& options, std::ostream& out, std::ostream& 
     s = RunNeesExperiment(options, err);
     wheel_note = WheelSeedNote(options.setup, LoadSimScenario(options.setup));
   } catch (const std::exception& e) {
-    err << "rover-eval nees: " << e.what() << "\n";
+    err << "rover-sim nees: " << e.what() << "\n";
     return kExitBadInput;
   }
   const double wall_s = Seconds(std::chrono::steady_clock::now() - wall_start);
 
-  out << "rover-eval nees: Monte Carlo consistency of the local reference filter\n";
+  out << "rover-sim nees: Monte Carlo consistency of the local reference filter\n";
   out << "scenario " << scenario_name << ", " << options.runs << " runs, seeds " << options.seed
       << ".." << RunSeed(options.seed, options.runs - 1) << "\n";
   out << "setup: " << options.setup.Describe() << "\n";
@@ -255,4 +264,4 @@ Subcommand AddNeesCommand(CLI::App& app) {
   return sub;
 }
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments

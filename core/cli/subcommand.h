@@ -1,7 +1,8 @@
-#ifndef ROVER_HOST_EVAL_SUBCOMMAND_H_
-#define ROVER_HOST_EVAL_SUBCOMMAND_H_
+#ifndef ROVER_CORE_CLI_SUBCOMMAND_H_
+#define ROVER_CORE_CLI_SUBCOMMAND_H_
 
-// How rover-eval's subcommands plug into its command line.
+// How a host tool's subcommands plug into its command line (rover-eval's,
+// and the simulator's experiments in rover-sim).
 //
 // Each subcommand lives in its own NAME_command.{h,cc} and provides
 //
@@ -14,16 +15,16 @@
 // function writing to streams (e.g. RunAte(options, out, err)) so tests call
 // it without a command line. rover_eval_main.cc calls every Add*Command once
 // and runs the one that was parsed. To add a subcommand: write the two files,
-// list the .cc in host/eval/CMakeLists.txt and add one line to
-// rover_eval_main.cc.
+// list the .cc in the tool's CMakeLists.txt and add one line to
+// its main.
 
 #include <CLI/CLI.hpp>
 
 #include <functional>
 
-namespace rover::host::eval {
+namespace rover::cli {
 
-/// Exit statuses of every rover-eval subcommand.
+/// Exit statuses of every subcommand.
 inline constexpr int kExitOk = 0;
 /// The evaluation ran but a check failed (for subcommands that check bounds).
 inline constexpr int kExitCheckFailed = 1;
@@ -36,6 +37,6 @@ struct Subcommand {
   std::function<int()> run;  ///< Runs it with the parsed options; returns the exit status.
 };
 
-}  // namespace rover::host::eval
+}  // namespace rover::cli
 
-#endif  // ROVER_HOST_EVAL_SUBCOMMAND_H_
+#endif  // ROVER_CORE_CLI_SUBCOMMAND_H_

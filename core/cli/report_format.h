@@ -1,14 +1,14 @@
-#ifndef ROVER_HOST_EVAL_REPORT_FORMAT_H_
-#define ROVER_HOST_EVAL_REPORT_FORMAT_H_
+#ifndef ROVER_CORE_CLI_REPORT_FORMAT_H_
+#define ROVER_CORE_CLI_REPORT_FORMAT_H_
 
-// Text formatting shared by the rover-eval subcommands: fixed-width tables
+// Text formatting shared by the command-line tools: fixed-width tables
 // and the machine-readable "RESULT key=value ..." line.
 
 #include <string>
 #include <utility>
 #include <vector>
 
-namespace rover::host::eval {
+namespace rover::cli {
 
 /// `value` with `decimals` digits after the point ("%.*f"); "nan" for NaN.
 std::string Fixed(double value, int decimals);
@@ -34,6 +34,6 @@ class TextTable {
 /// contain spaces.
 std::string ResultLine(const std::vector<std::pair<std::string, std::string>>& fields);
 
-}  // namespace rover::host::eval
+}  // namespace rover::cli
 
-#endif  // ROVER_HOST_EVAL_REPORT_FORMAT_H_
+#endif  // ROVER_CORE_CLI_REPORT_FORMAT_H_

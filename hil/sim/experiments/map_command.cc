@@ -1,4 +1,4 @@
-#include "host/eval/map_command.h"
+#include "hil/sim/experiments/map_command.h"
 
 #include <chrono>
 #include <cmath>
@@ -20,7 +20,11 @@
 #include "mapping/compose/map_export.h"
 #include "mapping/compose/submap_log.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
+
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitBadInput;
 namespace {
 
 // What the mission log tells about the run.
@@ -206,12 +210,12 @@ std::string MapResultFields(const MapResult& r) {
 
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err) {
   try {
-    out << "rover-eval map: " << options.mission_log << "\n";
+    out << "rover-sim map: " << options.mission_log << "\n";
     const MapResult r = EvaluateMission(options, out);
     out << "RESULT " << MapResultFields(r) << "\n";
     return kExitOk;
   } catch (const std::exception& e) {
-    err << "rover-eval map: " << e.what() << "\n";
+    err << "rover-sim map: " << e.what() << "\n";
     return kExitBadInput;
   }
 }
@@ -246,4 +250,4 @@ Subcommand AddMapCommand(CLI::App& app) {
   return {cmd, [options] { return RunMap(*options, std::cout, std::cerr); }};
 }
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments

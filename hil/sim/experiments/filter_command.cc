@@ -1,4 +1,4 @@
-#include "host/eval/sim_command.h"
+#include "hil/sim/experiments/filter_command.h"
 
 #include <algorithm>
 #include <atomic>
@@ -20,9 +20,18 @@
 #include "estimator/eskf/eskf_health.h"
 #include "estimator/eval/trajectory_evaluation.h"
 #include "hil/sim/sensors/wheel_odometry_model.h"
-#include "host/eval/report_format.h"
+#include "core/cli/report_format.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
+
+using cli::Fixed;
+using cli::General;
+using cli::TextTable;
+using cli::ResultLine;
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitCheckFailed;
+using cli::kExitBadInput;
 namespace {
 
 namespace ev = rover::eval;
@@ -64,7 +73,7 @@ double Mean(const std::vector<double>& values) {
   return sum / static_cast<double>(values.size());
 }
 
-// One simulated run of `rover-eval sim`.
+// One simulated run of `rover-sim filter`.
 struct SimRun {
   uint64_t seed = 0;
   double simulated_s = 0.0;
@@ -408,7 +417,7 @@ SimTrajectories BuildSimTrajectories(const sim::FilterFeed& feed,
   return t;
 }
 
-int RunSim(const SimCommandOptions& options, std::ostream& out, std::ostream& err) {
+int RunFilterCommand(const FilterCommandOptions& options, std::ostream& out, std::ostream& err) {
   const auto wall_start = std::chrono::steady_clock::now();
   std::vector<SimRun> runs;
   sim::Scenario scenario;
@@ -428,7 +437,7 @@ int RunSim(const SimCommandOptions& options, std::ostream& out, std::ostream& er
     evaluation.rpe.segment_lengths_m = options.segments_m;
 
     RunInParallel(
-        options.runs, options.jobs, "rover-eval sim",
+        options.runs, options.jobs, "rover-sim filter",
         [&](int i) {
           SimRun& run = runs[static_cast<std::size_t>(i)];
           run.seed = RunSeed(options.seed, i);
@@ -455,11 +464,11 @@ int RunSim(const SimCommandOptions& options, std::ostream& out, std::ostream& er
         },
         err);
   } catch (const std::exception& e) {
-    err << "rover-eval sim: " << e.what() << "\n";
+    err << "rover-sim filter: " << e.what() << "\n";
     return kExitBadInput;
   }
 
-  out << "rover-eval sim: scenario " << scenario.name << ", " << options.runs
+  out << "rover-sim filter: scenario " << scenario.name << ", " << options.runs
       << (options.runs == 1 ? " run" : " runs") << ", seed"
       << (options.runs == 1 ? " " + std::to_string(options.seed)
                             : "s " + std::to_string(options.seed) + ".." +
@@ -567,16 +576,16 @@ void AddSimSetupOptions(CLI::App* cmd, SimSetup* setup, std::string* wheels, int
       ->capture_default_str();
 }
 
-Subcommand AddSimCommand(CLI::App& app) {
+Subcommand AddFilterCommand(CLI::App& app) {
   struct State {
-    SimCommandOptions options;
+    FilterCommandOptions options;
     std::string wheels = "on";
   };
   auto state = std::make_shared<State>();
-  SimCommandOptions& o = state->options;
+  FilterCommandOptions& o = state->options;
 
   CLI::App* cmd = app.add_subcommand(
-      "sim",
+      "filter",
       "Runs the local reference filter alone on a simulated scenario (IMU, wheel speeds from\n"
       "the CAN bus, synthetic keyframe VO) and scores it against the ground truth: distance,\n"
       "final and mean position error (m and % of distance), ATE, RPE, attitude error, NEES,\n"
@@ -604,9 +613,9 @@ Subcommand AddSimCommand(CLI::App& app) {
   sub.app = cmd;
   sub.run = [state]() {
     state->options.setup.wheels = state->wheels == "on";
-    return RunSim(state->options, std::cout, std::cerr);
+    return RunFilterCommand(state->options, std::cout, std::cerr);
   };
   return sub;
 }
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments

@@ -1,7 +1,7 @@
-#ifndef ROVER_HOST_EVAL_NEES_COMMAND_H_
-#define ROVER_HOST_EVAL_NEES_COMMAND_H_
+#ifndef ROVER_HIL_SIM_EXPERIMENTS_NEES_COMMAND_H_
+#define ROVER_HIL_SIM_EXPERIMENTS_NEES_COMMAND_H_
 
-// `rover-eval nees`: Monte Carlo consistency of the local reference filter on
+// `rover-sim nees`: Monte Carlo consistency of the local reference filter on
 // the simulator (issue 4, "Quality"). N seeded runs of a scenario, the filter
 // alone; the synthetic VO's relative poses are ground truth perturbed by
 // exactly their stated covariance.
@@ -44,10 +44,15 @@
 #include <ostream>
 #include <vector>
 
-#include "host/eval/sim_command.h"
-#include "host/eval/subcommand.h"
+#include "hil/sim/experiments/filter_command.h"
+#include "core/cli/subcommand.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
+
+using cli::Subcommand;
+using cli::kExitOk;
+using cli::kExitCheckFailed;
+using cli::kExitBadInput;
 
 struct NeesCommandOptions {
   /// The default is the setup whose simulated sensors the filter models best:
@@ -121,9 +126,9 @@ NeesSummary RunNeesExperiment(const NeesCommandOptions& options, std::ostream& e
 /// not, kExitBadInput (message on `err`) for bad options or scenarios.
 int RunNees(const NeesCommandOptions& options, std::ostream& out, std::ostream& err);
 
-/// Adds `rover-eval nees` to `app` (see subcommand.h).
+/// Adds `rover-sim nees` to `app` (see subcommand.h).
 Subcommand AddNeesCommand(CLI::App& app);
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments
 
-#endif  // ROVER_HOST_EVAL_NEES_COMMAND_H_
+#endif  // ROVER_HIL_SIM_EXPERIMENTS_NEES_COMMAND_H_

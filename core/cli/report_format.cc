@@ -1,11 +1,11 @@
-#include "host/eval/report_format.h"
+#include "core/cli/report_format.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
-namespace rover::host::eval {
+namespace rover::cli {
 
 std::string Fixed(double value, int decimals) {
   if (std::isnan(value)) return "nan";
@@ -56,4 +56,4 @@ std::string ResultLine(const std::vector<std::pair<std::string, std::string>>& f
   return line;
 }
 
-}  // namespace rover::host::eval
+}  // namespace rover::cli

@@ -1,7 +1,7 @@
-#ifndef ROVER_HOST_EVAL_MAP_COMMAND_H_
-#define ROVER_HOST_EVAL_MAP_COMMAND_H_
+#ifndef ROVER_HIL_SIM_EXPERIMENTS_MAP_COMMAND_H_
+#define ROVER_HIL_SIM_EXPERIMENTS_MAP_COMMAND_H_
 
-// `rover-eval map`: the quality of the map of a simulated mission against the
+// `rover-sim map`: the quality of the map of a simulated mission against the
 // simulator's ground truth (map_evaluation.h), and the submap bandwidth.
 // Reads the mission's flight log (roverd: frame switches, estimates, the
 // mission's scenario, seed and start time) and mapd's log(s) (submaps),
@@ -11,10 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "host/eval/map_evaluation.h"
-#include "host/eval/subcommand.h"
+#include "hil/sim/experiments/map_evaluation.h"
+#include "core/cli/subcommand.h"
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
+
+using cli::Subcommand;
+using cli::kExitBadInput;
 
 struct MapCommandOptions {
   std::string mission_log;
@@ -50,9 +53,9 @@ std::string MapResultFields(const MapResult& r);
 /// Errors go to `err`; returns kExitBadInput for unusable input.
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err);
 
-/// Adds `rover-eval map` to `app` (see subcommand.h).
+/// Adds `rover-sim map` to `app` (see subcommand.h).
 Subcommand AddMapCommand(CLI::App& app);
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments
 
-#endif  // ROVER_HOST_EVAL_MAP_COMMAND_H_
+#endif  // ROVER_HIL_SIM_EXPERIMENTS_MAP_COMMAND_H_

@@ -1,4 +1,4 @@
-#include "host/eval/map_evaluation.h"
+#include "hil/sim/experiments/map_evaluation.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <unordered_set>
 #include <vector>
 
-namespace rover::host::eval {
+namespace rover::sim::experiments {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -216,4 +216,4 @@ MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
   return q;
 }
 
-}  // namespace rover::host::eval
+}  // namespace rover::sim::experiments
