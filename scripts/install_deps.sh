@@ -53,6 +53,7 @@ DEBIAN_PACKAGES=(
   libgpiod-dev               # libgpiod v1: GPIO trigger output and edge events (drivers/gpio)
   libusb-1.0-0-dev           # required by aravis-0.8.pc (pkg-config fails without it)
   libssl-dev                 # SHA-256 of served logs (OpenSSL libcrypto EVP), also needed by cpp-httplib
+  python3                    # scripts/check_link_graph.py: the library layering test (tests/architecture)
 )
 
 SUDO=""
