@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   for (const TagCarrier& c : world.carriers) {
     if (!c.is_static) carrier_poses.push_back(c.T_world_carrier);
   }
-  StereoFrame frame;
+  RenderedStereoFrame frame;
   double gl_s = 0.0;
   double readback_s = 0.0;
   double post_s = 0.0;

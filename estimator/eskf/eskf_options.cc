@@ -110,8 +110,8 @@ ZuptOptions ZuptOptions::Load(const ConfigNode& n) {
   return o;
 }
 
-HealthOptions HealthOptions::Load(const ConfigNode& n) {
-  HealthOptions o;
+EskfHealthOptions EskfHealthOptions::Load(const ConfigNode& n) {
+  EskfHealthOptions o;
   o.max_imu_gap_s = n.GetInRange<double>("max_imu_gap_s", 1e-4, 10.0, o.max_imu_gap_s);
   o.recovery_s = n.GetInRange<double>("recovery_s", 0.0, 60.0, o.recovery_s);
   o.aiding_timeout_s = n.GetInRange<double>("aiding_timeout_s", 0.01, 600.0, o.aiding_timeout_s);
@@ -126,7 +126,7 @@ EskfOptions EskfOptions::Load(const ConfigNode& n) {
   o.relative_pose = LoadSection<RelativePoseOptions>(n, "relative_pose");
   o.wheels = LoadSection<WheelOdometryOptions>(n, "wheels");
   o.zupt = LoadSection<ZuptOptions>(n, "zupt");
-  o.health = LoadSection<HealthOptions>(n, "health");
+  o.health = LoadSection<EskfHealthOptions>(n, "health");
   return o;
 }
 

@@ -119,13 +119,13 @@ struct ZuptOptions {
 };
 
 /// Bad-input handling and health.
-struct HealthOptions {
+struct EskfHealthOptions {
   double max_imu_gap_s = 0.05;    ///< longer intervals set kStatusImuGap
   double recovery_s = 0.5;        ///< flags clear after this long without new trouble
   double aiding_timeout_s = 2.0;  ///< kStatusNoAiding after this long without aiding
 
-  static HealthOptions Load(const ConfigNode& node);
-  friend bool operator==(const HealthOptions&, const HealthOptions&) = default;
+  static EskfHealthOptions Load(const ConfigNode& node);
+  friend bool operator==(const EskfHealthOptions&, const EskfHealthOptions&) = default;
 };
 
 /// Everything the local reference filter needs.
@@ -136,7 +136,7 @@ struct EskfOptions {
   RelativePoseOptions relative_pose;
   WheelOdometryOptions wheels;
   ZuptOptions zupt;
-  HealthOptions health;
+  EskfHealthOptions health;
 
   /// Reads the optional sections imu, init, clones, relative_pose, wheels,
   /// zupt and health of `node`. Throws ConfigError (file:line, key, expected,

@@ -110,9 +110,9 @@ int RunCan(const CanArgs& args) {
                                 : trajectory.duration_s();
   const rover::Time start = rover::Time::Now();
   const rover::drivers::ReplayClock clock(!args.lockstep, start);
-  rover::sim::WheelOdometryOptions wheels;
+  rover::sim::WheelOdometryModelOptions wheels;
   if (!scenario.wheels_config.empty()) {
-    wheels = rover::sim::WheelOdometryOptions::LoadFile(scenario.wheels_config);
+    wheels = rover::sim::WheelOdometryModelOptions::LoadFile(scenario.wheels_config);
   }
   rover::sim::SimWheelCanBus source(wheels, trajectory, world.terrain, clock, start,
                                     start + rover::Duration::FromSeconds(duration_s));

@@ -95,9 +95,9 @@ void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
   if (c.self == 0) result->distance_m = driven_m;
 
   // Wheel drives on the CAN bus.
-  WheelOdometryOptions wheel_options;
+  WheelOdometryModelOptions wheel_options;
   if (!c.scenario.wheels_config.empty()) {
-    wheel_options = WheelOdometryOptions::LoadFile(c.scenario.wheels_config);
+    wheel_options = WheelOdometryModelOptions::LoadFile(c.scenario.wheels_config);
   }
   WheelOdometryModel wheels(wheel_options, trajectory, c.world.terrain, t0);
   std::vector<drivers::CanFrame> frames;
@@ -117,7 +117,7 @@ void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
   const std::vector<Time> triggers = gpio.CameraTriggerTimes(t0, end);
   StereoRenderer renderer(c.world, camera);
   result->gl_renderer = renderer.gl_renderer();
-  StereoFrame frame;
+  RenderedStereoFrame frame;
   std::vector<const RoverTrajectory*> carriers;
   std::size_t hidden = kNoHiddenCarrier;
   for (std::size_t j = 0; j < c.carrier_rover.size(); ++j) {

@@ -60,7 +60,7 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
   trajectory_ = std::make_unique<RoverTrajectory>(scenario.route, world.terrain);
   const RoverTrajectory& trajectory = *trajectory_;
   if (!scenario.wheels_config.empty()) {
-    wheel_options_ = WheelOdometryOptions::LoadFile(scenario.wheels_config);
+    wheel_options_ = WheelOdometryModelOptions::LoadFile(scenario.wheels_config);
   }
   start_ = kDatasetStartTime;
   const double duration_s = options_.max_duration_s > 0.0

@@ -94,7 +94,7 @@ class FilterFeed {
 
   const Scenario& scenario() const { return scenario_; }
   const RoverTrajectory& trajectory() const { return *trajectory_; }
-  const WheelOdometryOptions& wheel_options() const { return wheel_options_; }
+  const WheelOdometryModelOptions& wheel_options() const { return wheel_options_; }
   const FilterFeedOptions& options() const { return options_; }
   uint64_t seed() const { return seed_; }
   Time start() const { return start_; }
@@ -108,7 +108,7 @@ class FilterFeed {
   uint64_t seed_ = 0;
   FilterFeedOptions options_;
   std::unique_ptr<RoverTrajectory> trajectory_;
-  WheelOdometryOptions wheel_options_;
+  WheelOdometryModelOptions wheel_options_;
   Time start_;
   Time end_;
   std::vector<estimator::EskfInput> inputs_;

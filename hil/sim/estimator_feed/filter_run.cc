@@ -161,7 +161,7 @@ estimator::EskfOptions EskfOptionsForFeed(const FilterFeed& feed) {
 
 estimator::EskfOptions EskfOptionsForScenario(const Scenario& scenario,
                                               const RoverTrajectory& trajectory,
-                                              const WheelOdometryOptions& wheel_options,
+                                              const WheelOdometryModelOptions& wheel_options,
                                               bool wheels_enabled) {
   estimator::EskfOptions o;
   const ImuModelOptions& imu = scenario.imu;

@@ -41,7 +41,7 @@ estimator::EskfOptions EskfOptionsForFeed(const FilterFeed& feed);
 /// The same for a scenario's rover without a feed (roverd on the simulator).
 estimator::EskfOptions EskfOptionsForScenario(const Scenario& scenario,
                                               const RoverTrajectory& trajectory,
-                                              const WheelOdometryOptions& wheel_options,
+                                              const WheelOdometryModelOptions& wheel_options,
                                               bool wheels_enabled);
 
 struct FilterRunOptions {

@@ -294,9 +294,9 @@ uint64_t RunSeed(uint64_t base_seed, int run) { return base_seed + static_cast<u
 
 std::string WheelSeedNote(const SimSetup& setup, const sim::Scenario& scenario) {
   if (!setup.wheels) return "";
-  const sim::WheelOdometryOptions wheels =
-      scenario.wheels_config.empty() ? sim::WheelOdometryOptions{}
-                                     : sim::WheelOdometryOptions::LoadFile(scenario.wheels_config);
+  const sim::WheelOdometryModelOptions wheels =
+      scenario.wheels_config.empty() ? sim::WheelOdometryModelOptions{}
+                                     : sim::WheelOdometryModelOptions::LoadFile(scenario.wheels_config);
   std::string where = scenario.wheels_config.empty() ? "the default" : scenario.wheels_config;
   return "note: the wheel model's slip, velocity-noise and CAN-timing streams are seeded by " +
          where + " (seed " + std::to_string(wheels.seed) +

@@ -7,7 +7,7 @@ namespace {
 constexpr Duration kSlice = Duration::Milliseconds(10);
 }  // namespace
 
-SimWheelCanBus::SimWheelCanBus(const WheelOdometryOptions& options,
+SimWheelCanBus::SimWheelCanBus(const WheelOdometryModelOptions& options,
                                const RoverTrajectory& trajectory, const Heightfield& terrain,
                                const drivers::ReplayClock& clock, Time start, Time end)
     : model_(options, trajectory, terrain, start),

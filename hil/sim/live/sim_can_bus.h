@@ -16,7 +16,7 @@ namespace rover::sim {
 class SimWheelCanBus final : public drivers::CanBus {
  public:
   /// `trajectory`, `terrain` and `clock` must outlive the bus.
-  SimWheelCanBus(const WheelOdometryOptions& options, const RoverTrajectory& trajectory,
+  SimWheelCanBus(const WheelOdometryModelOptions& options, const RoverTrajectory& trajectory,
                  const Heightfield& terrain, const drivers::ReplayClock& clock, Time start,
                  Time end);
   drivers::ReadStatus Receive(drivers::CanFrame* frame, Duration timeout) override;

@@ -37,7 +37,7 @@ class SimStereoCameraDriver final : public drivers::StereoCameraDriver {
   Time start_;
   Time end_;
   uint64_t next_index_ = 0;
-  StereoFrame rendered_;
+  RenderedStereoFrame rendered_;
   std::vector<Eigen::Isometry3d> T_world_carriers_;
 };
 

@@ -153,9 +153,9 @@ MissionResult RunMission(const MissionOptions& options) {
   // The recording rover's sensors, seeded as `rover-sim generate` seeds them.
   ImuModelOptions imu_options = scenario.imu;
   imu_options.seed = scenario.imu.seed ^ (options.seed * 0x9E3779B97F4A7C15ULL);
-  WheelOdometryOptions wheel_options;
+  WheelOdometryModelOptions wheel_options;
   if (!scenario.wheels_config.empty()) {
-    wheel_options = WheelOdometryOptions::LoadFile(scenario.wheels_config);
+    wheel_options = WheelOdometryModelOptions::LoadFile(scenario.wheels_config);
   }
   const drivers::ReplayClock clock(!options.lockstep, start);
   SimImuDriver imu(imu_options, trajectory, clock, start, end);

@@ -310,7 +310,7 @@ struct StereoRenderer::Impl {
   ~Impl();
   void Render(const Eigen::Isometry3d& T_world_body,
               const std::vector<Eigen::Isometry3d>& T_world_carriers, uint64_t frame_index,
-              StereoFrame* out);
+              RenderedStereoFrame* out);
 
   void ChooseRenderIntrinsics();
   void BuildMaps();
@@ -957,7 +957,7 @@ void StereoRenderer::Impl::RemapDepth(const cv::Mat& depth, cv::Mat* depth_m) co
 
 void StereoRenderer::Impl::Render(const Eigen::Isometry3d& T_world_body,
                                   const std::vector<Eigen::Isometry3d>& T_world_carriers,
-                                  uint64_t frame_index, StereoFrame* out) {
+                                  uint64_t frame_index, RenderedStereoFrame* out) {
   if (static_cast<int>(T_world_carriers.size()) != dynamic_carrier_count) {
     throw std::invalid_argument(
         "StereoRenderer::Render: expected " + std::to_string(dynamic_carrier_count) +
@@ -1032,7 +1032,7 @@ StereoRenderer::~StereoRenderer() = default;
 
 void StereoRenderer::Render(const Eigen::Isometry3d& T_world_body,
                             const std::vector<Eigen::Isometry3d>& T_world_carriers,
-                            uint64_t frame_index, StereoFrame* out) {
+                            uint64_t frame_index, RenderedStereoFrame* out) {
   impl_->Render(T_world_body, T_world_carriers, frame_index, out);
 }
 

@@ -84,7 +84,7 @@ struct RenderOptions {
 
 /// One hardware-triggered stereo exposure: both images and the depth belong
 /// to the same instant (the pose passed to Render).
-struct StereoFrame {
+struct RenderedStereoFrame {
   uint64_t frame_index = 0;
   cv::Mat cam0;  ///< CV_8UC1, height_px x width_px, distorted (as the lens delivers it)
   cv::Mat cam1;  ///< CV_8UC1, as cam0
@@ -120,7 +120,7 @@ class StereoRenderer {
   /// only when their size changes.
   void Render(const Eigen::Isometry3d& T_world_body,
               const std::vector<Eigen::Isometry3d>& T_world_carriers, uint64_t frame_index,
-              StereoFrame* out);
+              RenderedStereoFrame* out);
 
   /// GL_RENDERER of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
   const std::string& gl_renderer() const;

@@ -13,8 +13,8 @@ constexpr auto kSyncPeriod = Duration::Milliseconds(10);  // 100 Hz, DESIGN.md
 
 }  // namespace
 
-WheelOdometryOptions WheelOdometryOptions::Load(const ConfigNode& node) {
-  WheelOdometryOptions o;
+WheelOdometryModelOptions WheelOdometryModelOptions::Load(const ConfigNode& node) {
+  WheelOdometryModelOptions o;
   o.encoder_counts_per_motor_rev =
       node.GetInRange<uint32_t>("encoder_counts_per_motor_rev", 1, 1u << 24);
   o.gear_ratio = node.GetInRange<double>("gear_ratio", 1.0, 1000.0);
@@ -41,14 +41,14 @@ WheelOdometryOptions WheelOdometryOptions::Load(const ConfigNode& node) {
   return o;
 }
 
-WheelOdometryOptions WheelOdometryOptions::LoadFile(const std::string& path) {
+WheelOdometryModelOptions WheelOdometryModelOptions::LoadFile(const std::string& path) {
   const ConfigNode root = ConfigNode::LoadFile(path);
-  WheelOdometryOptions o = Load(root);
+  WheelOdometryModelOptions o = Load(root);
   root.CheckNoUnknownKeysRecursive();
   return o;
 }
 
-WheelOdometryModel::WheelOdometryModel(const WheelOdometryOptions& options,
+WheelOdometryModel::WheelOdometryModel(const WheelOdometryModelOptions& options,
                                        const RoverTrajectory& trajectory,
                                        const Heightfield& terrain, Time start)
     : options_(options),

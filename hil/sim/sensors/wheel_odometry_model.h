@@ -39,7 +39,7 @@
 
 namespace rover::sim {
 
-struct WheelOdometryOptions {
+struct WheelOdometryModelOptions {
   uint32_t encoder_counts_per_motor_rev = 4096;
   double gear_ratio = 100.0;  ///< motor revolutions per wheel revolution
   double yaw_scrub_factor = 1.0;
@@ -62,9 +62,9 @@ struct WheelOdometryOptions {
   double ticks_per_wheel_rev() const { return encoder_counts_per_motor_rev * gear_ratio; }
 
   /// Loads every key above (all required, same names) with range checks.
-  static WheelOdometryOptions Load(const ConfigNode& node);
+  static WheelOdometryModelOptions Load(const ConfigNode& node);
   /// Loads a whole file, rejecting unknown keys.
-  static WheelOdometryOptions LoadFile(const std::string& path);
+  static WheelOdometryModelOptions LoadFile(const std::string& path);
 };
 
 /// Ground truth of the drives at one SYNC (arrays in WheelIndex order).
@@ -83,7 +83,7 @@ class WheelOdometryModel {
  public:
   /// `trajectory` and `terrain` must outlive the model; trajectory time 0 is
   /// `start`, where every encoder reads 0.
-  WheelOdometryModel(const WheelOdometryOptions& options, const RoverTrajectory& trajectory,
+  WheelOdometryModel(const WheelOdometryModelOptions& options, const RoverTrajectory& trajectory,
                      const Heightfield& terrain, Time start);
 
   /// Appends to `frames` every frame stamped before `until`, in time order,
@@ -92,7 +92,7 @@ class WheelOdometryModel {
                std::vector<WheelSyncState>* states = nullptr);
 
   Time SyncTime(uint64_t k) const;
-  const WheelOdometryOptions& options() const { return options_; }
+  const WheelOdometryModelOptions& options() const { return options_; }
 
  private:
   struct WheelRates {
@@ -104,7 +104,7 @@ class WheelOdometryModel {
   void IntegrateTo(double t_s);
   void GenerateSync(uint64_t k, std::vector<WheelSyncState>* states);
 
-  WheelOdometryOptions options_;
+  WheelOdometryModelOptions options_;
   const RoverTrajectory& trajectory_;
   const Heightfield& terrain_;
   Time start_;

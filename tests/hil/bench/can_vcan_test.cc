@@ -50,8 +50,8 @@ std::vector<CanFrame> SimulatorRun(double duration_s) {
   route.end_hold_s = 0.5;
   route.DriveTo({4.0, 0.0}, 0.4).DriveTo({4.0, 4.0}, 0.3).DriveTo({0.0, 4.0}, 0.5).Revisit(-1, 0.4);
   const sim::RoverTrajectory trajectory(route, terrain);
-  const sim::WheelOdometryOptions options =
-      sim::WheelOdometryOptions::LoadFile(SourcePath("hil/config/wheels.yaml"));
+  const sim::WheelOdometryModelOptions options =
+      sim::WheelOdometryModelOptions::LoadFile(SourcePath("hil/config/wheels.yaml"));
   sim::WheelOdometryModel model(options, trajectory, terrain, kSimStart);
   std::vector<CanFrame> frames;
   model.Advance(kSimStart + Duration::FromSeconds(std::min(duration_s, trajectory.duration_s())),

@@ -69,7 +69,7 @@ TEST(TwoRoversTest, EachRoverSeesTheOthersTags) {
   StereoRenderer renderer(world, s.camera);
   const std::vector<const RoverTrajectory*> carriers = {&b, &a};  // world order: rover_b, rover_a
   std::vector<Eigen::Isometry3d> poses;
-  StereoFrame view;
+  RenderedStereoFrame view;
   MovingCarrierPoses(carriers, 1, t_meet, &poses);  // a's own body hidden
   renderer.Render(PoseOf(a.Evaluate(t_meet)), poses, 0, &view);
   EXPECT_TRUE(SeesAnyOf(view.cam0, TagIdsOf(world, "rover_b")))

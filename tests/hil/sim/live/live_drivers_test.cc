@@ -70,7 +70,7 @@ TEST(SimWheelCanBusTest, DeliversSyncAndFourTpdosEveryTenMilliseconds) {
   const Heightfield terrain = Flat();
   const RoverTrajectory trajectory(ShortRoute(), terrain);
   const drivers::ReplayClock lockstep(false, kStart);
-  SimWheelCanBus bus(WheelOdometryOptions{}, trajectory, terrain, lockstep, kStart,
+  SimWheelCanBus bus(WheelOdometryModelOptions{}, trajectory, terrain, lockstep, kStart,
                      kStart + Duration::Seconds(1));
   drivers::CanFrame frame;
   int syncs = 0, tpdos = 0, heartbeats = 0;

@@ -60,7 +60,7 @@ class MappingOnRenderTest : public ::testing::Test {
 
   /// Renders and maps the pair at `t_s` (the world as the local frame).
   void MapAt(double t_s) {
-    StereoFrame frame;
+    RenderedStereoFrame frame;
     T_world_body_ = BodyAt(t_s);
     renderer_->Render(T_world_body_, {}, static_cast<uint64_t>(t_s * 10), &frame);
     mapping::Submap submap(0, 0, {});

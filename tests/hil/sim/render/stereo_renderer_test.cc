@@ -81,7 +81,7 @@ TEST_F(TerrainRenderTest, RunsOnLlvmpipe) {
 TEST_F(TerrainRenderTest, DepthMatchesRaycastWithinOneCentimetreAtFiveMetres) {
   const StereoCameraOptions& camera = renderer_->camera();
   const Eigen::Isometry3d T_world_body = BodyPose(*world_, 0.4, -0.3, 0.35);
-  StereoFrame frame;
+  RenderedStereoFrame frame;
   renderer_->Render(T_world_body, {}, 0, &frame);
   ASSERT_EQ(frame.depth0_m.type(), CV_32FC1);
   ASSERT_EQ(frame.depth0_m.cols, camera.width_px);
@@ -177,7 +177,7 @@ TEST_F(TerrainRenderTest, DepthMatchesRaycastWithinOneCentimetreAtFiveMetres) {
 
 TEST_F(TerrainRenderTest, SgbmOnRectifiedPairMatchesGroundTruthDisparity) {
   const StereoCameraOptions& camera = renderer_->camera();
-  StereoFrame frame;
+  RenderedStereoFrame frame;
   renderer_->Render(BodyPose(*world_, -1.0, 2.0, -0.6), {}, 3, &frame);
 
   // Rectify with the calibration as sensor.yaml states it.
@@ -255,9 +255,9 @@ TEST_F(TerrainRenderTest, SgbmOnRectifiedPairMatchesGroundTruthDisparity) {
 
 TEST_F(TerrainRenderTest, IdenticalInputsGiveIdenticalBytes) {
   const Eigen::Isometry3d T_world_body = BodyPose(*world_, 2.0, 1.0, 1.2);
-  StereoFrame a;
-  StereoFrame b;
-  StereoFrame c;
+  RenderedStereoFrame a;
+  RenderedStereoFrame b;
+  RenderedStereoFrame c;
   renderer_->Render(T_world_body, {}, 17, &a);
   renderer_->Render(BodyPose(*world_, -3.0, 0.0, 0.0), {}, 16, &c);  // something in between
   renderer_->Render(T_world_body, {}, 17, &b);
@@ -272,7 +272,7 @@ TEST_F(TerrainRenderTest, IdenticalInputsGiveIdenticalBytes) {
 
   // A second renderer (its own GL context) gives the same bytes.
   StereoRenderer other(*world_, StereoCameraOptions());
-  StereoFrame d;
+  RenderedStereoFrame d;
   other.Render(T_world_body, {}, 17, &d);
   EXPECT_TRUE(SameBytes(a.cam0, d.cam0));
   EXPECT_TRUE(SameBytes(a.cam1, d.cam1));
@@ -287,8 +287,8 @@ TEST_F(TerrainRenderTest, ExposureAndGainScaleTheImage) {
   clean.apply_effects = false;
   StereoRenderer base_renderer(*world_, renderer_->camera(), clean);
   StereoRenderer bright_renderer(*world_, bright, clean);
-  StereoFrame base;
-  StereoFrame doubled;
+  RenderedStereoFrame base;
+  RenderedStereoFrame doubled;
   base_renderer.Render(T_world_body, {}, 0, &base);
   bright_renderer.Render(T_world_body, {}, 0, &doubled);
   // Unsaturated pixels double (within rounding).
@@ -324,7 +324,7 @@ TEST(TerrainLodRenderTest, NoCracksBetweenPatchesOfDifferentLevels) {
   options.max_terrain_error_px = 40.0;
   StereoRenderer renderer(world, StereoCameraOptions(), options);
   for (const double yaw : {0.0, 0.7, 2.0}) {
-    StereoFrame frame;
+    RenderedStereoFrame frame;
     renderer.Render(BodyPose(world, 0.3, 0.2, yaw), {}, 0, &frame);
     // Rows from 150 down look at the ground within ~5 m.
     const cv::Mat lower = frame.depth0_m.rowRange(150, frame.depth0_m.rows);
@@ -438,7 +438,7 @@ TEST(TagRenderTest, ApriltagDetectsRenderedTagsAtThreeMetresWithSubPixelCorners)
   const TagScene scene = MakeTagScene();
   const StereoCameraOptions camera;
   StereoRenderer renderer(scene.world, camera);
-  StereoFrame frame;
+  RenderedStereoFrame frame;
   renderer.Render(scene.T_world_body, {}, 0, &frame);
   const std::vector<Detection> detections = DetectTags(frame.cam0);
 
@@ -514,7 +514,7 @@ TEST(TagRenderTest, GeneratedLandmarkPostTagIsDetectedAtThreeMetres) {
   for (const TagCarrier& c : world.carriers) {
     if (!c.is_static) moving.push_back(c.T_world_carrier);
   }
-  StereoFrame frame;
+  RenderedStereoFrame frame;
   renderer.Render(T_world_body, moving, 0, &frame);
   const std::vector<Detection> detections = DetectTags(frame.cam0);
   const auto found = std::find_if(detections.begin(), detections.end(),

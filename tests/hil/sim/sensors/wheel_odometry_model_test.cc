@@ -38,7 +38,7 @@ std::vector<drivers::CanFrame> RunAll(WheelOdometryModel& model, const RoverTraj
 }
 
 TEST(WheelOdometryModelTest, OptionsLoadFromShippedYaml) {
-  const WheelOdometryOptions o = WheelOdometryOptions::LoadFile(ConfigPath("wheels.yaml"));
+  const WheelOdometryModelOptions o = WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
   EXPECT_EQ(o.encoder_counts_per_motor_rev, 4096u);
   EXPECT_EQ(o.ticks_per_wheel_rev(), 409600.0);
   EXPECT_EQ(o.heartbeat_phase_s, Eigen::Vector4d(0.11, 0.37, 0.62, 0.88));
@@ -50,7 +50,7 @@ TEST(WheelOdometryModelTest, OptionsLoadFromShippedYaml) {
 TEST(WheelOdometryModelTest, FrameIdsAndTiming) {
   const Heightfield terrain = testing::MakeRoughTerrain();
   const RoverTrajectory tr(StraightRoute(4.0, 0.3), terrain);
-  const WheelOdometryOptions o = WheelOdometryOptions::LoadFile(ConfigPath("wheels.yaml"));
+  const WheelOdometryModelOptions o = WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
   WheelOdometryModel model(o, tr, terrain, kStart);
   std::vector<drivers::CanFrame> frames;
   std::mt19937_64 rng(5);
@@ -121,7 +121,7 @@ TEST(WheelOdometryModelTest, FrameIdsAndTiming) {
 TEST(WheelOdometryModelTest, TicksMatchWheelRotationWithoutSlip) {
   const Heightfield flat = testing::MakeFlatTerrain();
   const RoverTrajectory tr(StraightRoute(6.0, 0.3), flat);
-  WheelOdometryOptions o;  // ideal: no slip, no noise, no scrub
+  WheelOdometryModelOptions o;  // ideal: no slip, no noise, no scrub
   WheelOdometryModel model(o, tr, flat, kStart);
   std::vector<WheelSyncState> states;
   const std::vector<drivers::CanFrame> frames = RunAll(model, tr, &states);
@@ -163,7 +163,7 @@ TEST(WheelOdometryModelTest, TurnOnTheSpotCountsLeftBackRightForward) {
   for (const PhaseInterval& p : tr.phases()) {
     if (p.phase == MotionPhase::kTurnInPlace) turn_end = p.end_s;
   }
-  WheelOdometryOptions o;
+  WheelOdometryModelOptions o;
   o.yaw_scrub_factor = 1.3;
   WheelOdometryModel model(o, tr, flat, kStart);
   std::vector<WheelSyncState> states;
@@ -180,7 +180,7 @@ TEST(WheelOdometryModelTest, TurnOnTheSpotCountsLeftBackRightForward) {
   EXPECT_GT(s.encoder_ticks[kFrontRight], 0);
 }
 
-double MeanCruiseSlip(const Heightfield& terrain, const WheelOdometryOptions& o) {
+double MeanCruiseSlip(const Heightfield& terrain, const WheelOdometryModelOptions& o) {
   const RoverTrajectory tr(StraightRoute(6.0, 0.3), terrain);
   WheelOdometryModel model(o, tr, terrain, kStart);
   std::vector<WheelSyncState> states;
@@ -196,7 +196,7 @@ double MeanCruiseSlip(const Heightfield& terrain, const WheelOdometryOptions& o)
 }
 
 TEST(WheelOdometryModelTest, SlipGrowsOnSlopesAndRoughGround) {
-  WheelOdometryOptions o = WheelOdometryOptions::LoadFile(ConfigPath("wheels.yaml"));
+  WheelOdometryModelOptions o = WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
   const double flat = MeanCruiseSlip(testing::MakeFlatTerrain(), o);
   const double slope = MeanCruiseSlip(testing::MakeInclinedPlane(12.0 * M_PI / 180.0), o);
   const double rough = MeanCruiseSlip(testing::MakeHeightfield(
@@ -219,7 +219,7 @@ TEST(WheelOdometryModelTest, SlipGrowsOnSlopesAndRoughGround) {
 TEST(WheelOdometryModelTest, SameSeedSameFrames) {
   const Heightfield terrain = testing::MakeRoughTerrain();
   const RoverTrajectory tr(StraightRoute(3.0, 0.3), terrain);
-  WheelOdometryOptions o = WheelOdometryOptions::LoadFile(ConfigPath("wheels.yaml"));
+  WheelOdometryModelOptions o = WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
   WheelOdometryModel a(o, tr, terrain, kStart), b(o, tr, terrain, kStart);
   o.seed += 1;
   WheelOdometryModel c(o, tr, terrain, kStart);
