@@ -24,13 +24,6 @@ double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-// A submap that goes into the map, and where.
-struct Placement {
-  std::size_t log = 0;
-  std::size_t submap = 0;
-  Eigen::Isometry3d T_map_submap = Eigen::Isometry3d::Identity();
-};
-
 // Occupied finest voxels: a pruned occupied leaf counts for every voxel it
 // covers.
 uint64_t OccupiedVoxels(const octomap::OcTree& tree) {
@@ -127,43 +120,30 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
     origins = ChainSubmapOrigins(logs.front().submaps);
   }
 
-  // The submaps that can be placed; the map's resolution is the first
-  // submap's (mapd uses one for all).
-  double resolution_m = 0.0;
-  for (const mapping::SubmapLog& l : logs) {
-    if (!l.submaps.empty()) {
-      resolution_m = l.submaps.front().octree->getResolution();
-      break;
-    }
-  }
-  std::vector<Placement> placements;
+  // The submaps that can be placed (mapping/compose's one placement rule).
+  const mapping::SubmapPlacements placement = mapping::PlaceLoggedSubmaps(logs, origins);
+  const double resolution_m = placement.resolution_m;
+  const std::vector<mapping::SubmapPlacement>& placements = placement.placed;
   std::vector<std::vector<bool>> placed(logs.size());
+  for (std::size_t l = 0; l < logs.size(); ++l) placed[l].assign(logs[l].submaps.size(), false);
+  for (const mapping::SubmapPlacement& p : placements) placed[p.log][p.submap] = true;
   std::vector<std::string> unplaced;
-  for (std::size_t l = 0; l < logs.size(); ++l) {
-    placed[l].assign(logs[l].submaps.size(), false);
-    for (std::size_t s = 0; s < logs[l].submaps.size(); ++s) {
-      const mapping::LoggedSubmap& submap = logs[l].submaps[s];
-      const std::string name = "log " + std::to_string(l + 1) + " submap " +
-                               std::to_string(submap.info.index) + " (frame " +
-                               std::to_string(submap.info.frame_id) + ")";
-      const auto origin = origins.find(submap.info.frame_id);
-      if (origin == origins.end()) {
-        unplaced.push_back(name + ": " +
-                           (options.roverd_log.empty()
-                                ? WhyUnplaced(submap.info, origins)
-                                : "no frame switch of " + options.roverd_log + " reaches frame " +
-                                      std::to_string(submap.info.frame_id)));
-        continue;
-      }
-      if (submap.octree->getResolution() != resolution_m) {
-        char why[128];
-        std::snprintf(why, sizeof why, ": octree resolution %.3f m, the map's is %.3f m",
-                      submap.octree->getResolution(), resolution_m);
-        unplaced.push_back(name + why);
-        continue;
-      }
-      placements.push_back({l, s, origin->second});
-      placed[l][s] = true;
+  for (const mapping::UnplacedSubmap& u : placement.unplaced) {
+    const log::rover_msgs::SubmapInfo& info = logs[u.log].submaps[u.submap].info;
+    const std::string name = "log " + std::to_string(u.log + 1) + " submap " +
+                             std::to_string(info.index) + " (frame " +
+                             std::to_string(info.frame_id) + ")";
+    if (u.reason == mapping::UnplacedSubmap::Reason::kResolution) {
+      char why[128];
+      std::snprintf(why, sizeof why, ": octree resolution %.3f m, the map's is %.3f m",
+                    u.resolution_m, resolution_m);
+      unplaced.push_back(name + why);
+    } else {
+      unplaced.push_back(name + ": " +
+                         (options.roverd_log.empty()
+                              ? WhyUnplaced(info, origins)
+                              : "no frame switch of " + options.roverd_log + " reaches frame " +
+                                    std::to_string(info.frame_id)));
     }
   }
 
@@ -206,7 +186,7 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
   try {
     composer.emplace(composer_options);
     for (std::size_t i = 0; i < placements.size(); ++i) {
-      const Placement& p = placements[i];
+      const mapping::SubmapPlacement& p = placements[i];
       const mapping::LoggedSubmap& s = logs[p.log].submaps[p.submap];
       composer->SetSubmap(static_cast<uint32_t>(i), s.octree, s.cloud, p.T_map_submap);
       if (show_progress && ((i + 1) % progress_step == 0 || i + 1 == placements.size())) {

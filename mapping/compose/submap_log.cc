@@ -138,23 +138,42 @@ std::map<uint32_t, Eigen::Isometry3d> ReadFrameOrigins(const std::string& roverd
   return origins;
 }
 
+SubmapPlacements PlaceLoggedSubmaps(const std::vector<SubmapLog>& logs,
+                                    const std::map<uint32_t, Eigen::Isometry3d>& origins) {
+  SubmapPlacements p;
+  for (const SubmapLog& l : logs) {
+    if (!l.submaps.empty()) {
+      p.resolution_m = l.submaps.front().octree->getResolution();
+      break;
+    }
+  }
+  for (std::size_t l = 0; l < logs.size(); ++l) {
+    for (std::size_t s = 0; s < logs[l].submaps.size(); ++s) {
+      const LoggedSubmap& submap = logs[l].submaps[s];
+      const double resolution_m = submap.octree->getResolution();
+      const auto origin = origins.find(submap.info.frame_id);
+      if (origin == origins.end()) {
+        p.unplaced.push_back({l, s, UnplacedSubmap::Reason::kNoOrigin, resolution_m});
+      } else if (resolution_m != p.resolution_m) {
+        p.unplaced.push_back({l, s, UnplacedSubmap::Reason::kResolution, resolution_m});
+      } else {
+        p.placed.push_back({l, s, origin->second});
+      }
+    }
+  }
+  return p;
+}
+
 std::size_t AddLoggedSubmaps(const std::vector<SubmapLog>& logs,
                              const std::map<uint32_t, Eigen::Isometry3d>& origins,
                              MapComposer* composer) {
-  std::size_t unplaced = 0;
-  // Ids in log order, then submap order: composition order is id order.
+  const SubmapPlacements placements = PlaceLoggedSubmaps(logs, origins);
   uint32_t id = 0;
-  for (const SubmapLog& l : logs) {
-    for (const LoggedSubmap& s : l.submaps) {
-      const auto origin = origins.find(s.info.frame_id);
-      if (origin == origins.end()) {
-        ++unplaced;
-        continue;
-      }
-      composer->SetSubmap(id++, s.octree, s.cloud, origin->second);
-    }
+  for (const SubmapPlacement& p : placements.placed) {
+    const LoggedSubmap& s = logs[p.log].submaps[p.submap];
+    composer->SetSubmap(id++, s.octree, s.cloud, p.T_map_submap);
   }
-  return unplaced;
+  return placements.unplaced.size();
 }
 
 }  // namespace rover::mapping

@@ -60,9 +60,41 @@ SubmapLog ReadSubmapLog(const std::string& path);
 /// switch that does not chain (its old frame was never reached).
 std::map<uint32_t, Eigen::Isometry3d> ReadFrameOrigins(const std::string& roverd_log_path);
 
-/// Places the submaps of `logs` at `origins` (by SubmapInfo::frame_id) into
-/// `composer`, keyed by (log number, submap index) so that submaps of a
-/// restarted mapd do not collide. Returns how many had no origin.
+/// Where one logged submap goes: logs[log].submaps[submap] at T_map_submap.
+struct SubmapPlacement {
+  std::size_t log = 0;
+  std::size_t submap = 0;
+  Eigen::Isometry3d T_map_submap = Eigen::Isometry3d::Identity();
+};
+
+/// A logged submap that cannot go into the map, and why.
+struct UnplacedSubmap {
+  enum class Reason {
+    kNoOrigin,    ///< no origin for its SubmapInfo::frame_id
+    kResolution,  ///< its octree resolution differs from the map's
+  };
+  std::size_t log = 0;
+  std::size_t submap = 0;
+  Reason reason = Reason::kNoOrigin;
+  double resolution_m = 0.0;  ///< the submap's octree resolution
+};
+
+/// The placement of every submap of a set of mapd logs.
+struct SubmapPlacements {
+  double resolution_m = 0.0;  ///< the map's: the first submap's (mapd uses one for all)
+  std::vector<SubmapPlacement> placed;  ///< in log, then submap order (the order mapd built them)
+  std::vector<UnplacedSubmap> unplaced;
+};
+
+/// The one placement rule of logged submaps: a submap goes at the origin of
+/// its frame (`origins` by SubmapInfo::frame_id) if it has one and its octree
+/// has the map's resolution (voxels of another size cannot be merged).
+SubmapPlacements PlaceLoggedSubmaps(const std::vector<SubmapLog>& logs,
+                                    const std::map<uint32_t, Eigen::Isometry3d>& origins);
+
+/// Places the submaps of `logs` by PlaceLoggedSubmaps() into `composer`,
+/// keyed by placement order so that submaps of a restarted mapd do not
+/// collide. Returns how many could not be placed.
 std::size_t AddLoggedSubmaps(const std::vector<SubmapLog>& logs,
                              const std::map<uint32_t, Eigen::Isometry3d>& origins,
                              MapComposer* composer);
