@@ -49,6 +49,33 @@ void LockstepGate::FrameDone() {
   changed_.notify_all();
 }
 
+void LockstepGate::WaitForImuAt(Time capture) {
+  std::unique_lock lock(mutex_);
+  // The IMU thread waits for this frame's result once it steps past
+  // capture + vo_latency: then it has stepped everything up to the capture
+  // already unless the latency is shorter than an IMU period; either way
+  // going on cannot deadlock.
+  changed_.wait(lock, [&] {
+    return stopped_ || imu_ended_ || imu_done_ >= capture || imu_target_ - vo_latency_ >= capture;
+  });
+}
+
+void LockstepGate::ImuStepped(Time t) {
+  {
+    const std::lock_guard lock(mutex_);
+    imu_done_ = t;
+  }
+  changed_.notify_all();
+}
+
+void LockstepGate::ImuEnded() {
+  {
+    const std::lock_guard lock(mutex_);
+    imu_ended_ = true;
+  }
+  changed_.notify_all();
+}
+
 void LockstepGate::CameraEnded() {
   {
     const std::lock_guard lock(mutex_);

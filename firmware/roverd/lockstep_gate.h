@@ -10,7 +10,11 @@
 //   - the CAN thread has handed over a frame stamped at or after t, or holds
 //     one stamped after t.
 // The camera and CAN threads in turn stay at most `lead` ahead of the time
-// the IMU thread is stepping to, so the hand-over rings never overflow. With real sensors none of
+// the IMU thread is stepping to, so the hand-over rings never overflow. The
+// VO thread starts a frame only once the IMU thread has stepped every sample
+// up to its capture time, so what it reads of the filter (whether it has
+// initialised) is that of the capture time, not of how far the IMU thread
+// happened to run: the run is then a function of its inputs alone. With real sensors none of
 // this is used: each thread runs on its own clock and the IMU thread never waits.
 
 #include <condition_variable>
@@ -38,6 +42,13 @@ class LockstepGate {
   void FrameSkipped(Time capture);
   /// VO thread: the oldest queued frame is done (its result handed over).
   void FrameDone();
+  /// VO thread: blocks until the IMU thread has stepped every sample up to
+  /// `capture` (or ended, or waits for this frame's result itself).
+  void WaitForImuAt(Time capture);
+  /// IMU thread: the sample at `t` is stepped and its state published.
+  void ImuStepped(Time t);
+  /// IMU thread: no more samples.
+  void ImuEnded();
   void CameraEnded();
   /// CAN thread: a frame stamped `stamp` arrived; blocks while it is more
   /// than `lead` ahead of the time the IMU thread is stepping to.
@@ -58,6 +69,8 @@ class LockstepGate {
   std::mutex mutex_;
   std::condition_variable changed_;
   Time imu_target_ = Time::FromNanoseconds(INT64_MIN / 2);  // what the IMU steps to next
+  Time imu_done_ = Time::FromNanoseconds(INT64_MIN / 2);    // the last sample stepped
+  bool imu_ended_ = false;
   std::deque<Time> frames_in_flight_;
   Time camera_through_ = Time::FromNanoseconds(INT64_MIN / 2);
   bool camera_ended_ = false;

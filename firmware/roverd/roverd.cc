@@ -1,8 +1,11 @@
 #include "firmware/roverd/roverd.h"
 
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 #include <string>
+
+#include "estimator/feed/keyframe_at_filter_init.h"
 
 namespace rover::roverd {
 namespace {
@@ -167,7 +170,9 @@ void Roverd::ImuLoop(RoverdStats* stats) {
     if (filter_init_ns_.load(std::memory_order_relaxed) == 0 && loop_.filter().initialised()) {
       filter_init_ns_.store(sample.stamp.nanoseconds(), std::memory_order_release);
     }
+    if (options_.lockstep) gate_.ImuStepped(sample.stamp);
   }
+  gate_.ImuEnded();
 }
 
 int Roverd::AcquireSlot() {
@@ -229,7 +234,7 @@ void Roverd::TriggerThread() {
 }
 
 void Roverd::VoThread() {
-  bool keyframe_requested = false;
+  estimator::KeyframeAtFilterInit keyframe_at_init;
   while (true) {
     int slot = -1;
     if (!to_vo_.TryPop(&slot)) {
@@ -250,11 +255,11 @@ void Roverd::VoThread() {
     FrameSlot& s = slots_[static_cast<std::size_t>(slot)];
     // The filter holds clones only from its initialisation on: a keyframe
     // captured before cannot be used, so ask for one captured after it.
+    if (options_.lockstep) gate_.WaitForImuAt(s.capture);
     const int64_t init_ns = filter_init_ns_.load(std::memory_order_acquire);
-    if (!keyframe_requested && init_ns != 0 && s.capture.nanoseconds() > init_ns) {
-      vo_->RequestKeyframe();
-      keyframe_requested = true;
-    }
+    const std::optional<Time> init =
+        init_ns != 0 ? std::optional<Time>(Time::FromNanoseconds(init_ns)) : std::nullopt;
+    if (keyframe_at_init.ShouldRequest(s.capture, init)) vo_->RequestKeyframe();
     estimator::vo::StereoImages images;
     images.capture = s.capture;
     images.cam0 = s.cam0;
