@@ -10,8 +10,7 @@
 //    ground truth, with the bounds for the mean NEES;
 //  * QuoteRpe: which RPE segment length a single figure quotes;
 //  * AlignAtPose / EvaluateAlignedAtStart: errors of an estimate aligned
-//    only at its first pose;
-//  * Percentile: timing percentiles.
+//    only at its first pose.
 
 #include <Eigen/Geometry>
 #include <cstddef>
