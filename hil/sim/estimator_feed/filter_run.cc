@@ -7,6 +7,7 @@
 #include "core/geometry/so3.h"
 #include "core/geometry/yaw.h"
 #include "estimator/eskf/local_reference_filter.h"
+#include "estimator/feed/filter_options.h"
 
 namespace rover::sim {
 namespace {
@@ -163,36 +164,18 @@ estimator::EskfOptions EskfOptionsForScenario(const Scenario& scenario,
                                               const RoverTrajectory& trajectory,
                                               const WheelOdometryModelOptions& wheel_options,
                                               bool wheels_enabled) {
-  estimator::EskfOptions o;
-  const ImuModelOptions& imu = scenario.imu;
-  o.imu.rate_hz = imu.rate_hz;
-  o.imu.gyro_noise_density_rad_s_sqrt_hz = imu.gyro.noise_density;
-  o.imu.gyro_bias_random_walk_rad_s2_sqrt_hz = imu.gyro.bias_random_walk;
-  o.imu.accel_noise_density_m_s2_sqrt_hz = imu.accel.noise_density;
-  o.imu.accel_bias_random_walk_m_s3_sqrt_hz = imu.accel.bias_random_walk;
-  // An ideal (unbounded) sensor never saturates: keep the filter's limit high.
+  // The simulated rover's calibration, through the rule every board uses.
+  calib::BoardCalibration calibration;
+  calibration.imu = ImuCalibrationOf(scenario.imu);
+  if (wheels_enabled) calibration.wheels = WheelCalibrationOf(trajectory, wheel_options);
+  estimator::EskfOptions o = estimator::FilterOptionsFromCalibration(calibration);
+  // What no calibration file states. An ideal (unbounded) sensor never
+  // saturates: keep the filter's limit high.
   constexpr double kUnbounded = 1e4;
+  const ImuModelOptions& imu = scenario.imu;
   o.imu.gyro_range_rad_s = std::isfinite(imu.gyro.range) ? imu.gyro.range : kUnbounded;
   o.imu.accel_range_m_s2 = std::isfinite(imu.accel.range) ? imu.accel.range : kUnbounded;
   o.imu.gravity_m_s2 = kStandardGravity_m_s2;
-
-  const RoverTrajectoryOptions& rover = trajectory.options();
-  o.wheels.enabled = wheels_enabled;
-  o.wheels.wheel_radius_m = rover.wheel_radius_m;
-  o.wheels.track_m = rover.track_m;
-  o.wheels.yaw_scrub_factor = wheel_options.yaw_scrub_factor;
-  // The wheel-axle centre: the mean of the four wheel centres.
-  Eigen::Vector3d axle = Eigen::Vector3d::Zero();
-  for (int w = 0; w < kWheelCount; ++w) axle += trajectory.WheelCenterBody(w);
-  o.wheels.lever_arm_body_m = axle / kWheelCount;
-  // The simulated rover's planar path is that of the body origin (the IMU):
-  // it is the point without sideways velocity (a real rover's is the wheel
-  // contact centre, the filter's default).
-  o.wheels.nonholonomic_point_body_m = Eigen::Vector3d::Zero();
-  // The wheel-terrain slip calibration: the simulator's mean slip against
-  // tilt (its roughness term and slip noise stay unmodelled).
-  o.wheels.slip_ratio_base = wheel_options.slip_base_ratio;
-  o.wheels.slip_ratio_per_tilt_rad = wheel_options.slip_slope_gain_per_rad;
   return o;
 }
 

@@ -85,6 +85,16 @@ ImuModelOptions ImuModelOptions::LoadFile(const std::string& path) {
   return o;
 }
 
+calib::ImuCalibration ImuCalibrationOf(const ImuModelOptions& options) {
+  calib::ImuCalibration c;
+  c.rate_hz = options.rate_hz;
+  c.gyro_noise_density_rad_s_sqrt_hz = options.gyro.noise_density;
+  c.gyro_random_walk_rad_s2_sqrt_hz = options.gyro.bias_random_walk;
+  c.accel_noise_density_m_s2_sqrt_hz = options.accel.noise_density;
+  c.accel_random_walk_m_s3_sqrt_hz = options.accel.bias_random_walk;
+  return c;
+}
+
 ImuModelOptions ImuModelOptions::Ideal() const {
   ImuModelOptions o;
   o.model = "ideal";

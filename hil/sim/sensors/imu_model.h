@@ -22,6 +22,7 @@
 #include <random>
 #include <string>
 
+#include "core/calib/imu_calibration.h"
 #include "core/config/config.h"
 #include "core/time/time.h"
 #include "drivers/imu/imu_sample.h"
@@ -67,6 +68,10 @@ struct ImuModelOptions {
   /// Every error source off (same rate and seed): an ideal IMU.
   ImuModelOptions Ideal() const;
 };
+
+/// What a calibration of this simulated IMU would state: its rate and noise
+/// densities, mounted at the body origin (the simulator's body is the IMU).
+calib::ImuCalibration ImuCalibrationOf(const ImuModelOptions& options);
 
 class ImuModel {
  public:

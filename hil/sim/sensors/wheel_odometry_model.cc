@@ -48,6 +48,21 @@ WheelOdometryModelOptions WheelOdometryModelOptions::LoadFile(const std::string&
   return o;
 }
 
+calib::WheelCalibration WheelCalibrationOf(const RoverTrajectory& trajectory,
+                                           const WheelOdometryModelOptions& options) {
+  calib::WheelCalibration c;
+  c.wheel_radius_m = trajectory.options().wheel_radius_m;
+  c.track_m = trajectory.options().track_m;
+  Eigen::Vector3d axle = Eigen::Vector3d::Zero();
+  for (int w = 0; w < kWheelCount; ++w) axle += trajectory.WheelCenterBody(w);
+  c.lever_arm_body_m = axle / kWheelCount;
+  c.nonholonomic_point_body_m = Eigen::Vector3d::Zero();
+  c.yaw_scrub_factor = options.yaw_scrub_factor;
+  c.slip_ratio_base = options.slip_base_ratio;
+  c.slip_ratio_per_tilt_rad = options.slip_slope_gain_per_rad;
+  return c;
+}
+
 WheelOdometryModel::WheelOdometryModel(const WheelOdometryModelOptions& options,
                                        const RoverTrajectory& trajectory,
                                        const Heightfield& terrain, Time start)

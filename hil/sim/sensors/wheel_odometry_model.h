@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "core/calib/wheel_calibration.h"
 #include "core/config/config.h"
 #include "core/time/time.h"
 #include "drivers/can/can_frame.h"
@@ -78,6 +79,15 @@ struct WheelSyncState {
   std::array<double, kWheelCount> roughness_m{};
   double tilt_rad = 0.0;
 };
+
+/// What a wheel calibration of the simulated rover would find: its wheel
+/// radius and track, the mean of its wheel centres as the lever arm, the body
+/// origin as the point without sideways velocity (the simulated planar path
+/// is the body origin's; a real rover's is its wheel-contact centre), its yaw
+/// scrub, and its mean slip against tilt (the roughness term and the slip
+/// noise stay uncalibrated, as a field calibration would leave them).
+calib::WheelCalibration WheelCalibrationOf(const RoverTrajectory& trajectory,
+                                           const WheelOdometryModelOptions& options);
 
 class WheelOdometryModel {
  public:
