@@ -24,6 +24,7 @@
 #include "core/geometry/yaw.h"
 #include "estimator/eval/csv_trajectory.h"
 #include "estimator/eval/eval_error.h"
+#include "host/eval/can_frames_csv.h"
 #include "host/eval/vio_command.h"
 #include "host/eval/vio_evaluation.h"
 #include "tests/support/temp_dir.h"
@@ -278,78 +279,6 @@ TEST(AlignedAtStartTest, Se3AlignsTheWholeFirstPose) {
   // Yaw alone cannot undo that frame's roll and pitch.
   EXPECT_GT(EvaluateAlignedAtStart(poses, ev::AlignmentMethod::kFourDof).final_error_m, 0.6);
   EXPECT_THROW(AlignAtPose(poses.front(), ev::AlignmentMethod::kSim3), std::invalid_argument);
-}
-
-// -------------------------------------------------------- option loading
-
-drivers::ImuCalibration TestImu() {
-  drivers::ImuCalibration imu;
-  imu.rate_hz = 200.0;
-  imu.gyroscope_noise_density_rad_s_sqrt_hz = 1.6968e-4;
-  imu.gyroscope_random_walk_rad_s2_sqrt_hz = 1.9393e-5;
-  imu.accelerometer_noise_density_m_s2_sqrt_hz = 2.0e-3;
-  imu.accelerometer_random_walk_m_s3_sqrt_hz = 3.0e-3;
-  return imu;
-}
-
-TEST(VioFilterOptionsTest, DatasetImuAndMaxClonesUnderTheFile) {
-  const estimator::EskfOptions base = VioFilterOptions(TestImu(), std::nullopt, "");
-  EXPECT_EQ(base.imu.rate_hz, 200.0);
-  EXPECT_EQ(base.imu.accel_noise_density_m_s2_sqrt_hz, 2.0e-3);
-  EXPECT_EQ(base.clones.max_clones, estimator::kMaxClones);
-  EXPECT_FALSE(base.wheels.enabled);
-
-  testing::TempDir dir;
-  const std::string path =
-      WriteFile(dir, "filter.yaml", "imu:\n  rate_hz: 100\ninit:\n  window_s: 0.25\n");
-  const estimator::EskfOptions o = VioFilterOptions(TestImu(), std::nullopt, path);
-  EXPECT_EQ(o.imu.rate_hz, 100.0);                               // the file's
-  EXPECT_EQ(o.imu.gyro_noise_density_rad_s_sqrt_hz, 1.6968e-4);  // the dataset's
-  EXPECT_EQ(o.init.window_s, 0.25);
-  EXPECT_EQ(o.clones.max_clones, estimator::kMaxClones);
-}
-
-TEST(VioFilterOptionsTest, WheelGeometryFromTheSimulator) {
-  SimWheelGeometry g;
-  g.wheel_radius_m = 0.1;
-  g.track_m = 0.5;
-  g.body_height_m = 0.35;
-  g.yaw_scrub_factor = 1.3;
-  const estimator::EskfOptions o = VioFilterOptions(TestImu(), g, "");
-  EXPECT_TRUE(o.wheels.enabled);
-  EXPECT_EQ(o.wheels.track_m, 0.5);
-  EXPECT_EQ(o.wheels.yaw_scrub_factor, 1.3);
-  EXPECT_LT((o.wheels.lever_arm_body_m - Eigen::Vector3d(0.0, 0.0, -0.25)).norm(), 1e-12);
-}
-
-TEST(VioFilterOptionsTest, ShippedEurocConfigLoads) {
-  const char* source = std::getenv("ROVER_SOURCE_DIR");
-  ASSERT_NE(source, nullptr) << "ROVER_SOURCE_DIR is set by rover_add_test";
-  const estimator::EskfOptions o = VioFilterOptions(
-      TestImu(), std::nullopt, std::string(source) + "/host/eval/config/euroc_mav.yaml");
-  EXPECT_EQ(o.init.window_s, 0.5);
-  EXPECT_FALSE(o.zupt.enabled);
-  EXPECT_FALSE(o.wheels.enabled);
-  EXPECT_EQ(o.imu.accel_noise_density_m_s2_sqrt_hz, 2.0e-3);
-}
-
-TEST(VioFilterOptionsTest, BadFileIsAnErrorNamingIt) {
-  testing::TempDir dir;
-  const std::string path = WriteFile(dir, "bad.yaml", "init:\n  window_sec: 0.5\n");
-  try {
-    VioFilterOptions(TestImu(), std::nullopt, path);
-    FAIL() << "expected a ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("bad.yaml"));
-    EXPECT_THAT(e.what(), HasSubstr("window_sec"));
-  }
-}
-
-TEST(VioVoOptionsTest, NominalRateFromTheCameraUnlessTheFileSetsIt) {
-  EXPECT_EQ(VioVoOptions(20.0, "").checks.nominal_rate_hz, 20.0);
-  testing::TempDir dir;
-  const std::string path = WriteFile(dir, "vo.yaml", "checks:\n  nominal_rate_hz: 10\n");
-  EXPECT_EQ(VioVoOptions(20.0, path).checks.nominal_rate_hz, 10.0);
 }
 
 // ------------------------------------------------------------ CAN reader
