@@ -3,7 +3,7 @@
 # PeriodicTimer + LoopProbe on a SCHED_FIFO RtThread) against cyclictest from
 # Debian's rt-tests, with the same priority, period and loop count, at 1 kHz
 # and 400 Hz. Prints p50 / p99 / p99.9 / max of both tools' wake-up latency
-# and of our sample-to-estimate latency, and checks the targets of issue 7:
+# and of our sample-to-estimate latency, and checks the real-time targets:
 #   wake-up p99.9 within 10 % of cyclictest's    (ratio ours/cyclictest <= 1.10)
 #   estimate p99.9 at most 100 us above cyclictest's wake-up p99.9.
 #

@@ -4,7 +4,7 @@
 // batches) and as a ratio against a dense reference implementation of the
 // same operation measured in the same run (full-matrix Phi P Phi^T, Joseph
 // form with explicit (I - KH), J P J^T), since the machines are shared and
-// absolute times drift. Targets (issue 4): propagate <= 2 us, update <= 20 us,
+// absolute times drift. Targets: propagate <= 2 us, update <= 20 us,
 // switch <= 20 us.
 
 #include <Eigen/Dense>

@@ -11,7 +11,7 @@
 //     prior (full search) for features the full search did not match, as for
 //     newly detected features.
 // "same" counts points that the other run also accepted with the right pixel
-// within 0.01 px. Target (issue 5): full search <= 5 ms for 300 features with
+// within 0.01 px. Target: full search <= 5 ms for 300 features with
 // the reference's accepted count +-5 %.
 //
 // usage: bench_stereo_matcher [EUROC_DIR]   (default: the shared excerpt)

@@ -3,7 +3,7 @@
 // EuRoC-layout dataset (default: the real 752 x 480 EuRoC excerpt; pass a
 // simulator dataset for rover-like motion). Images are decoded before timing.
 //
-// Target (issue 5): <= 25 ms per frame at 752 x 480 on one core. For a
+// Target: <= 25 ms per frame at 752 x 480 on one core. For a
 // reference measured in the same run (the shared machines drift), the bench
 // also times a bare KLT front-end step on the same frames: remap of both
 // images, pyramids, and forward + backward pyramidal KLT of 300 features, the

@@ -186,7 +186,7 @@ void EstimatorLoop::OnFrameSwitch(const estimator::FrameSwitchRecord& record) {
 }
 
 void EstimatorLoop::OnPoseReport(const estimator::PoseReport& /*report*/) {
-  // Pose reports go to mapd's graph (issue 8); nothing requests them yet.
+  // Pose reports go to mapd's graph; nothing requests them yet.
 }
 
 void EstimatorLoop::OnReject(const estimator::RejectRecord& /*record*/) {

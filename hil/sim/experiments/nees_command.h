@@ -2,7 +2,7 @@
 #define ROVER_HIL_SIM_EXPERIMENTS_NEES_COMMAND_H_
 
 // `rover-sim nees`: Monte Carlo consistency of the local reference filter on
-// the simulator (issue 4, "Quality"). N seeded runs of a scenario, the filter
+// the simulator. N seeded runs of a scenario, the filter
 // alone; the synthetic VO's relative poses are ground truth perturbed by
 // exactly their stated covariance.
 //

@@ -1,4 +1,4 @@
-// rover-eval vio (issue 5): the evaluation math on synthetic inputs with
+// rover-eval vio: the evaluation math on synthetic inputs with
 // known answers, the option and CAN readers, and the whole command on the
 // real EuRoC V1_01 micro excerpt (ROVER_SHARED_DIR, a few seconds).
 
