@@ -30,10 +30,10 @@
 #include <string>
 #include <vector>
 
+#include "core/calib/stereo_rectifier.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/stereo_matcher.h"
-#include "estimator/vo/stereo_rectifier.h"
 #include "tests/estimator/vo/euroc_vo_util.h"
 #include "tests/estimator/vo/stereo_matcher_reference.h"
 
@@ -75,7 +75,7 @@ int Same(const std::vector<StereoPoint>& a, const std::vector<StereoPoint>& b) {
 int Run(const std::string& dir) {
   const auto cam0 = drivers::LoadCameraCalibration(dir + "/mav0/cam0/sensor.yaml");
   const auto cam1 = drivers::LoadCameraCalibration(dir + "/mav0/cam1/sensor.yaml");
-  const auto rectifier = StereoRectifier::Create(ToModel(cam0), ToModel(cam1));
+  const auto rectifier = calib::StereoRectifier::Create(ToModel(cam0), ToModel(cam1));
   if (!rectifier.has_value()) {
     std::fprintf(stderr, "unusable calibration in %s\n", dir.c_str());
     return 1;

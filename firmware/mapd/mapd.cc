@@ -47,8 +47,8 @@ std::unique_ptr<ipc::Publisher<T>> Advertise(ipc::Transport* transport, std::str
   return p;
 }
 
-estimator::vo::CameraModel CameraOf(const topics::CameraCalibrationMsg& m) {
-  estimator::vo::CameraModel c;
+calib::CameraModel CameraOf(const topics::CameraCalibrationMsg& m) {
+  calib::CameraModel c;
   c.width_px = m.width_px;
   c.height_px = m.height_px;
   c.intrinsics = m.intrinsics;

@@ -2,9 +2,9 @@
 
 namespace rover::roverd {
 
-estimator::vo::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
-                                         const Eigen::Isometry3d& T_imu_body) {
-  estimator::vo::CameraModel m;
+calib::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
+                                 const Eigen::Isometry3d& T_imu_body) {
+  calib::CameraModel m;
   m.width_px = c.width_px;
   m.height_px = c.height_px;
   m.intrinsics = c.intrinsics;

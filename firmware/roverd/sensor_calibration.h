@@ -9,17 +9,17 @@
 
 #include <Eigen/Geometry>
 
+#include "core/calib/camera_model.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/eskf/eskf_options.h"
-#include "estimator/vo/stereo_rectifier.h"
 
 namespace rover::roverd {
 
 /// A camera's calibration as the VO's camera model, with T_body_cam
 /// expressed in the filter's body frame (the IMU frame): `T_imu_body` is
 /// the inverse of the IMU's T_body_imu.
-estimator::vo::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
-                                         const Eigen::Isometry3d& T_imu_body);
+calib::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
+                                 const Eigen::Isometry3d& T_imu_body);
 
 /// The filter's options: the EskfOptions file at `path` if given (complete;
 /// absent keys take the defaults), else the defaults with the IMU's own

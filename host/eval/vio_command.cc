@@ -125,9 +125,9 @@ class Progress {
   std::size_t last_decile_ = 0;
 };
 
-vo::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
-                              const Eigen::Isometry3d& T_imu_body) {
-  vo::CameraModel m;
+calib::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
+                                 const Eigen::Isometry3d& T_imu_body) {
+  calib::CameraModel m;
   m.width_px = c.width_px;
   m.height_px = c.height_px;
   m.intrinsics = c.intrinsics;
@@ -203,7 +203,7 @@ std::size_t NextStream(const std::array<std::optional<Time>, kStreamCount>& head
 
 // The VO of the run; throws DatasetError naming `calibration_files` when the
 // calibration is unusable.
-vo::StereoOdometry MakeVo(const vo::CameraModel& cam0, const vo::CameraModel& cam1,
+vo::StereoOdometry MakeVo(const calib::CameraModel& cam0, const calib::CameraModel& cam1,
                           const vo::StereoOdometryOptions& options,
                           const std::string& calibration_files) {
   std::string error;

@@ -6,14 +6,14 @@
 
 #include <Eigen/Geometry>
 
+#include "core/calib/stereo_rectifier.h"
 #include "drivers/replay/euroc_dataset.h"
-#include "estimator/vo/stereo_rectifier.h"
 
 namespace rover::estimator::vo::testing {
 
 /// The VO's camera model of an EuRoC sensor.yaml calibration (T_body_cam = T_BS).
-inline CameraModel ToModel(const drivers::CameraCalibration& c) {
-  CameraModel m;
+inline calib::CameraModel ToModel(const drivers::CameraCalibration& c) {
+  calib::CameraModel m;
   m.width_px = c.width_px;
   m.height_px = c.height_px;
   m.intrinsics = c.intrinsics;
