@@ -31,8 +31,6 @@
 namespace rover::estimator::vo {
 namespace {
 
-using testing::ToModel;
-
 double Percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -103,7 +101,7 @@ int Run(const Options& o) {
   VoHealth health;
   for (int pass = 0; pass < o.passes; ++pass) {
     std::string error;
-    auto vo = StereoOdometry::Create(ToModel(d.cam0()), ToModel(d.cam1()), options, &error);
+    auto vo = StereoOdometry::Create(d.cam0(), d.cam1(), options, &error);
     if (!vo) {
       std::fprintf(stderr, "%s: %s\n", o.dataset.c_str(), error.c_str());
       return 2;
@@ -112,7 +110,7 @@ int Run(const Options& o) {
     health = vo->health();
   }
   // Reference: the bare KLT step over consecutive frames, 300 features of the first.
-  auto rectifier = calib::StereoRectifier::Create(ToModel(d.cam0()), ToModel(d.cam1()));
+  auto rectifier = calib::StereoRectifier::Create(d.cam0(), d.cam1());
   cv::Mat r0, r1;
   rectifier->Rectify(frames[0].cam0, frames[0].cam1, &r0, &r1);
   std::vector<cv::Point2f> features = FeatureDetector().Detect(r0);

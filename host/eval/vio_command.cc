@@ -125,13 +125,8 @@ class Progress {
   std::size_t last_decile_ = 0;
 };
 
-calib::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
-                                 const Eigen::Isometry3d& T_imu_body) {
-  calib::CameraModel m;
-  m.width_px = c.width_px;
-  m.height_px = c.height_px;
-  m.intrinsics = c.intrinsics;
-  m.distortion = c.distortion;
+calib::CameraModel ToCameraModel(const calib::CameraModel& c, const Eigen::Isometry3d& T_imu_body) {
+  calib::CameraModel m = c;
   // The filter's body is the IMU frame.
   m.T_body_cam = T_imu_body * c.T_body_cam;
   return m;
@@ -313,7 +308,7 @@ SimWheelGeometry LoadSimWheelGeometry(const std::string& config_dir) {
   return g;
 }
 
-EskfOptions VioFilterOptions(const drivers::ImuCalibration& imu,
+EskfOptions VioFilterOptions(const calib::ImuCalibration& imu,
                              const std::optional<SimWheelGeometry>& wheels,
                              const std::string& filter_config_path) {
   EskfOptions base;
@@ -321,13 +316,11 @@ EskfOptions VioFilterOptions(const drivers::ImuCalibration& imu,
   const auto set_if_positive = [](double value, double* option) {
     if (value > 0.0) *option = value;
   };
-  set_if_positive(imu.gyroscope_noise_density_rad_s_sqrt_hz,
-                  &base.imu.gyro_noise_density_rad_s_sqrt_hz);
-  set_if_positive(imu.gyroscope_random_walk_rad_s2_sqrt_hz,
+  set_if_positive(imu.gyro_noise_density_rad_s_sqrt_hz, &base.imu.gyro_noise_density_rad_s_sqrt_hz);
+  set_if_positive(imu.gyro_random_walk_rad_s2_sqrt_hz,
                   &base.imu.gyro_bias_random_walk_rad_s2_sqrt_hz);
-  set_if_positive(imu.accelerometer_noise_density_m_s2_sqrt_hz,
-                  &base.imu.accel_noise_density_m_s2_sqrt_hz);
-  set_if_positive(imu.accelerometer_random_walk_m_s3_sqrt_hz,
+  set_if_positive(imu.accel_noise_density_m_s2_sqrt_hz, &base.imu.accel_noise_density_m_s2_sqrt_hz);
+  set_if_positive(imu.accel_random_walk_m_s3_sqrt_hz,
                   &base.imu.accel_bias_random_walk_m_s3_sqrt_hz);
   base.clones.max_clones = estimator::kMaxClones;
   base.wheels.enabled = wheels.has_value();

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "core/calib/imu_calibration.h"
 #include "drivers/can/can_frame.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/eskf/eskf_health.h"
@@ -81,7 +82,7 @@ SimWheelGeometry LoadSimWheelGeometry(const std::string& config_dir);
 /// options from `wheels` (or wheels disabled without it); then every key the
 /// YAML file `filter_config_path` (if not empty) sets overrides the above.
 /// Throws ConfigError (naming the file, line and key) for a bad file.
-estimator::EskfOptions VioFilterOptions(const drivers::ImuCalibration& imu,
+estimator::EskfOptions VioFilterOptions(const calib::ImuCalibration& imu,
                                         const std::optional<SimWheelGeometry>& wheels,
                                         const std::string& filter_config_path);
 

@@ -23,8 +23,6 @@
 namespace rover::estimator::vo {
 namespace {
 
-using testing::ToModel;
-
 using Clock = std::chrono::steady_clock;
 
 double Ms(Clock::time_point a, Clock::time_point b) {
@@ -38,7 +36,7 @@ class EurocVoTest : public ::testing::Test {
     const std::string dir =
         std::string(shared != nullptr ? shared : "../shared") + "/data/euroc_v1_01_micro";
     dataset_ = drivers::EurocDataset::Load(dir, dir + "/groundtruth/V1_01_easy_openvins.csv");
-    auto rect = calib::StereoRectifier::Create(ToModel(dataset_.cam0()), ToModel(dataset_.cam1()));
+    auto rect = calib::StereoRectifier::Create(dataset_.cam0(), dataset_.cam1());
     ASSERT_TRUE(rect.has_value());
     rectifier_ = std::move(*rect);
   }

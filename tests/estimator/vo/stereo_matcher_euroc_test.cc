@@ -20,8 +20,6 @@
 namespace rover::estimator::vo {
 namespace {
 
-using testing::ToModel;
-
 // Points of `a` that `b` accepted too, with the right pixel within `tolerance_px`.
 int Same(const std::vector<StereoPoint>& a, const std::vector<StereoPoint>& b, float tolerance_px) {
   int same = 0;
@@ -42,8 +40,7 @@ TEST(StereoMatcherEurocTest, AgreesWithTheExhaustiveSearch) {
   const std::string dir =
       std::string(shared != nullptr ? shared : "../shared") + "/data/euroc_v1_01_micro";
   const auto dataset = drivers::EurocDataset::Load(dir);
-  const auto rectifier =
-      calib::StereoRectifier::Create(ToModel(dataset.cam0()), ToModel(dataset.cam1()));
+  const auto rectifier = calib::StereoRectifier::Create(dataset.cam0(), dataset.cam1());
   ASSERT_TRUE(rectifier.has_value());
   const StereoMatcher matcher(rectifier->intrinsics(), rectifier->baseline_m());
   for (const size_t frame : {0u, 40u, 80u}) {

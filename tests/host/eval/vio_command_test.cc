@@ -294,13 +294,13 @@ TEST(AlignedAtStartTest, Se3AlignsTheWholeFirstPose) {
 
 // -------------------------------------------------------- option loading
 
-drivers::ImuCalibration TestImu() {
-  drivers::ImuCalibration imu;
+calib::ImuCalibration TestImu() {
+  calib::ImuCalibration imu;
   imu.rate_hz = 200.0;
-  imu.gyroscope_noise_density_rad_s_sqrt_hz = 1.6968e-4;
-  imu.gyroscope_random_walk_rad_s2_sqrt_hz = 1.9393e-5;
-  imu.accelerometer_noise_density_m_s2_sqrt_hz = 2.0e-3;
-  imu.accelerometer_random_walk_m_s3_sqrt_hz = 3.0e-3;
+  imu.gyro_noise_density_rad_s_sqrt_hz = 1.6968e-4;
+  imu.gyro_random_walk_rad_s2_sqrt_hz = 1.9393e-5;
+  imu.accel_noise_density_m_s2_sqrt_hz = 2.0e-3;
+  imu.accel_random_walk_m_s3_sqrt_hz = 3.0e-3;
   return imu;
 }
 
