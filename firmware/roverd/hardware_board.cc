@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/calib/board_calibration.h"
 #include "core/calib/euroc_sensor_yaml.h"
 #include "drivers/camera/aravis_camera.h"
 #include "drivers/camera/stereo_pairer.h"
@@ -97,12 +98,12 @@ HardwareBoard::HardwareBoard(const runtime::BoardHardwareOptions& options) {
   options_.estimator = FilterOptionsFromCalibration(imu, options.estimator_config);
   options_.estimator.imu.rate_hz = options.imu.rate_hz;
   if (options.camera) {
-    const Eigen::Isometry3d T_imu_body = imu.T_body_imu.inverse();
     CameraSetup head;
-    head.cam0 = ToCameraModel(CameraCalibrationFor(options.calibration, "cam0", *options.camera),
-                              T_imu_body);
-    head.cam1 = ToCameraModel(CameraCalibrationFor(options.calibration, "cam1", *options.camera),
-                              T_imu_body);
+    // The filter's body is the IMU frame.
+    head.cam0 = calib::CameraInImuFrame(
+        CameraCalibrationFor(options.calibration, "cam0", *options.camera), imu);
+    head.cam1 = calib::CameraInImuFrame(
+        CameraCalibrationFor(options.calibration, "cam1", *options.camera), imu);
     if (!options.vo_config.empty()) {
       head.vo = estimator::vo::StereoOdometryOptions::LoadFile(options.vo_config);
     }

@@ -2,12 +2,6 @@
 
 namespace rover::roverd {
 
-calib::CameraModel ToCameraModel(const calib::CameraModel& c, const Eigen::Isometry3d& T_imu_body) {
-  calib::CameraModel m = c;
-  m.T_body_cam = T_imu_body * c.T_body_cam;  // the filter's body is the IMU frame
-  return m;
-}
-
 estimator::EskfOptions FilterOptionsFromCalibration(const calib::ImuCalibration& imu,
                                                     const std::string& path) {
   // A given file is complete (absent keys take the defaults); without one the

@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "core/calib/board_calibration.h"
 #include "core/config/config.h"
 #include "estimator/eskf/local_reference_filter.h"
 #include "estimator/eval/csv_trajectory.h"
@@ -124,13 +125,6 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
   std::size_t last_decile_ = 0;
 };
-
-calib::CameraModel ToCameraModel(const calib::CameraModel& c, const Eigen::Isometry3d& T_imu_body) {
-  calib::CameraModel m = c;
-  // The filter's body is the IMU frame.
-  m.T_body_cam = T_imu_body * c.T_body_cam;
-  return m;
-}
 
 // The dataset's ground truth of the IMU frame (the filter's body).
 ev::Trajectory TruthTrajectory(const drivers::EurocDataset& data, const std::string& source) {
@@ -483,10 +477,11 @@ VioRun RunVioExperiment(const VioCommandOptions& options, std::ostream& err) {
                                                       : "options from " + options.vo_config_path) +
                       ", nominal rate " + General(vo_options.checks.nominal_rate_hz) + " Hz");
 
-  const Eigen::Isometry3d T_imu_body = data.imu_calibration().T_body_imu.inverse();
-  vo::StereoOdometry vo = MakeVo(
-      ToCameraModel(data.cam0(), T_imu_body), ToCameraModel(data.cam1(), T_imu_body), vo_options,
-      (mav0 / "cam0/sensor.yaml").string() + " and " + (mav0 / "cam1/sensor.yaml").string());
+  // The filter's body is the IMU frame.
+  vo::StereoOdometry vo =
+      MakeVo(calib::CameraInImuFrame(data.cam0(), data.imu_calibration()),
+             calib::CameraInImuFrame(data.cam1(), data.imu_calibration()), vo_options,
+             (mav0 / "cam0/sensor.yaml").string() + " and " + (mav0 / "cam1/sensor.yaml").string());
 
   // The span of the run: IMU from one initialisation window before the first
   // capture (if the dataset has it) to the delivery of the last VO result.
