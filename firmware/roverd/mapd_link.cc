@@ -40,6 +40,9 @@ topics::CameraCalibrationMsg ToCameraMsg(const calib::CameraModel& cam) {
   topics::CameraCalibrationMsg m;
   m.width_px = cam.width_px;
   m.height_px = cam.height_px;
+  m.distortion_model = cam.distortion_model == calib::DistortionModel::kEquidistant
+                           ? topics::kDistortionEquidistant
+                           : topics::kDistortionRadialTangential;
   m.intrinsics = cam.intrinsics;
   m.distortion = cam.distortion;
   const Eigen::Vector3d p = cam.T_body_cam.translation();
