@@ -30,17 +30,16 @@
 #include <string>
 #include <vector>
 
+#include "core/calib/euroc_sensor_yaml.h"
+#include "core/calib/stereo_rectifier.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/stereo_matcher.h"
-#include "estimator/vo/stereo_rectifier.h"
 #include "tests/estimator/vo/euroc_vo_util.h"
 #include "tests/estimator/vo/stereo_matcher_reference.h"
 
 namespace rover::estimator::vo {
 namespace {
-
-using testing::ToModel;
 
 constexpr int kCalls = 21;
 constexpr size_t kFrames[] = {0, 50, 80};
@@ -73,9 +72,9 @@ int Same(const std::vector<StereoPoint>& a, const std::vector<StereoPoint>& b) {
 }
 
 int Run(const std::string& dir) {
-  const auto cam0 = drivers::LoadCameraCalibration(dir + "/mav0/cam0/sensor.yaml");
-  const auto cam1 = drivers::LoadCameraCalibration(dir + "/mav0/cam1/sensor.yaml");
-  const auto rectifier = StereoRectifier::Create(ToModel(cam0), ToModel(cam1));
+  const auto cam0 = calib::LoadEurocCamera(dir + "/mav0/cam0/sensor.yaml");
+  const auto cam1 = calib::LoadEurocCamera(dir + "/mav0/cam1/sensor.yaml");
+  const auto rectifier = calib::StereoRectifier::Create(cam0, cam1);
   if (!rectifier.has_value()) {
     std::fprintf(stderr, "unusable calibration in %s\n", dir.c_str());
     return 1;

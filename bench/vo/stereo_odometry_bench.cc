@@ -59,7 +59,7 @@ Options Parse(int argc, char** argv) {
 }
 
 // Remap, pyramids and forward-backward KLT of `features` from frame a to b [ms].
-double ReferenceKltMs(const StereoRectifier& rectifier, const StereoImages& a,
+double ReferenceKltMs(const calib::StereoRectifier& rectifier, const StereoImages& a,
                       const StereoImages& b, const std::vector<cv::Point2f>& features) {
   const auto t0 = std::chrono::steady_clock::now();
   cv::Mat a0, a1, b0, b1;
@@ -97,7 +97,7 @@ int Run(const Options& o) {
   VoHealth health;
   for (int pass = 0; pass < o.passes; ++pass) {
     std::string error;
-    auto vo = StereoOdometry::Create(ToModel(d.cam0()), ToModel(d.cam1()), options, &error);
+    auto vo = StereoOdometry::Create(d.cam0(), d.cam1(), options, &error);
     if (!vo) {
       std::fprintf(stderr, "%s: %s\n", o.dataset.c_str(), error.c_str());
       return 2;
@@ -106,7 +106,7 @@ int Run(const Options& o) {
     health = vo->health();
   }
   // Reference: the bare KLT step over consecutive frames, 300 features of the first.
-  auto rectifier = StereoRectifier::Create(ToModel(d.cam0()), ToModel(d.cam1()));
+  auto rectifier = calib::StereoRectifier::Create(d.cam0(), d.cam1());
   cv::Mat r0, r1;
   rectifier->Rectify(frames[0].cam0, frames[0].cam1, &r0, &r1);
   std::vector<cv::Point2f> features = FeatureDetector().Detect(r0);

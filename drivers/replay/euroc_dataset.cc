@@ -1,7 +1,5 @@
 #include "drivers/replay/euroc_dataset.h"
 
-#include <opencv2/core.hpp>
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -9,6 +7,8 @@
 #include <fstream>
 #include <map>
 #include <optional>
+
+#include "core/calib/euroc_sensor_yaml.h"
 
 namespace rover::drivers {
 namespace {
@@ -169,96 +169,7 @@ std::vector<GroundTruthState> LoadGroundTruth(const std::string& path) {
   return states;
 }
 
-cv::FileStorage OpenYaml(const std::string& path) {
-  if (!fs::exists(path)) throw DatasetError(path + ": missing");
-  try {
-    cv::FileStorage storage(path, cv::FileStorage::READ);
-    if (!storage.isOpened()) throw DatasetError(path + ": cannot parse as YAML");
-    return storage;
-  } catch (const cv::Exception& e) {
-    throw DatasetError(path + ": cannot parse as YAML: " + e.msg);
-  }
-}
-
-std::vector<double> Numbers(const cv::FileStorage& fs, const std::string& path, const char* key,
-                            std::size_t expected) {
-  std::vector<double> values;
-  const cv::FileNode node = fs[key];
-  if (node.isSeq()) node >> values;
-  if (values.size() != expected) {
-    throw DatasetError(path + ": " + key + ": expected " + std::to_string(expected) +
-                       " numbers, found " + std::to_string(values.size()));
-  }
-  return values;
-}
-
-Eigen::Isometry3d ReadTbs(const cv::FileStorage& fs, const std::string& path) {
-  std::vector<double> data;
-  const cv::FileNode node = fs["T_BS"]["data"];
-  if (node.isSeq()) node >> data;
-  if (data.size() != 16) {
-    throw DatasetError(path + ": T_BS.data: expected 16 numbers (4x4 row-major), found " +
-                       std::to_string(data.size()));
-  }
-  Eigen::Matrix4d m;
-  for (int r = 0; r < 4; ++r) {
-    for (int col = 0; col < 4; ++col) m(r, col) = data[static_cast<std::size_t>(4 * r + col)];
-  }
-  const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
-  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-4) {
-    throw DatasetError(path + ": T_BS: rotation part is not orthonormal");
-  }
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  // Re-orthonormalise: published calibrations carry ~1e-6 rounding.
-  T.linear() = Eigen::Quaterniond(R).normalized().toRotationMatrix();
-  T.translation() = m.topRightCorner<3, 1>();
-  return T;
-}
-
-double ReadDouble(const cv::FileStorage& fs, const std::string& path, const char* key) {
-  const cv::FileNode node = fs[key];
-  if (!node.isReal() && !node.isInt()) {
-    throw DatasetError(path + ": " + key + ": expected a number");
-  }
-  return static_cast<double>(node);
-}
-
 }  // namespace
-
-CameraCalibration LoadCameraCalibration(const std::string& path) {
-  const cv::FileStorage fs = OpenYaml(path);
-  CameraCalibration c;
-  const std::vector<double> resolution = Numbers(fs, path, "resolution", 2);
-  c.width_px = static_cast<int>(resolution[0]);
-  c.height_px = static_cast<int>(resolution[1]);
-  c.rate_hz = ReadDouble(fs, path, "rate_hz");
-  const std::string model = static_cast<std::string>(fs["camera_model"]);
-  const std::string distortion = static_cast<std::string>(fs["distortion_model"]);
-  if (model != "pinhole" || distortion != "radial-tangential") {
-    throw DatasetError(path +
-                       ": expected camera_model pinhole with distortion_model "
-                       "radial-tangential, found '" +
-                       model + "' / '" + distortion + "'");
-  }
-  const std::vector<double> k = Numbers(fs, path, "intrinsics", 4);
-  const std::vector<double> d = Numbers(fs, path, "distortion_coefficients", 4);
-  std::copy(k.begin(), k.end(), c.intrinsics.begin());
-  std::copy(d.begin(), d.end(), c.distortion.begin());
-  c.T_body_cam = ReadTbs(fs, path);
-  return c;
-}
-
-ImuCalibration LoadImuCalibration(const std::string& path) {
-  const cv::FileStorage fs = OpenYaml(path);
-  ImuCalibration c;
-  c.rate_hz = ReadDouble(fs, path, "rate_hz");
-  c.gyroscope_noise_density_rad_s_sqrt_hz = ReadDouble(fs, path, "gyroscope_noise_density");
-  c.gyroscope_random_walk_rad_s2_sqrt_hz = ReadDouble(fs, path, "gyroscope_random_walk");
-  c.accelerometer_noise_density_m_s2_sqrt_hz = ReadDouble(fs, path, "accelerometer_noise_density");
-  c.accelerometer_random_walk_m_s3_sqrt_hz = ReadDouble(fs, path, "accelerometer_random_walk");
-  c.T_body_imu = ReadTbs(fs, path);
-  return c;
-}
 
 EurocDataset EurocDataset::Load(const std::string& dir, const std::string& ground_truth_csv) {
   const fs::path mav0 = fs::path(dir) / "mav0";
@@ -268,9 +179,11 @@ EurocDataset EurocDataset::Load(const std::string& dir, const std::string& groun
   EurocDataset d;
   d.dir_ = dir;
   d.imu_ = LoadImu((mav0 / "imu0/data.csv").string());
-  d.imu_calibration_ = LoadImuCalibration((mav0 / "imu0/sensor.yaml").string());
-  d.cam0_ = LoadCameraCalibration((mav0 / "cam0/sensor.yaml").string());
-  d.cam1_ = LoadCameraCalibration((mav0 / "cam1/sensor.yaml").string());
+  try {
+    d.calibration_ = calib::LoadEurocCalibration(mav0.string());
+  } catch (const calib::CalibrationError& e) {
+    throw DatasetError(e.what());  // the dataset's one error type, same message
+  }
 
   const auto rows0 = LoadCameraRows(mav0 / "cam0", &d.issues_);
   const auto rows1 = LoadCameraRows(mav0 / "cam1", &d.issues_);

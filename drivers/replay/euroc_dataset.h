@@ -12,16 +12,17 @@
 // timestamp or a calibration with the wrong shape is an error naming the file
 // and line; a camera row whose image file does not exist is not an error but
 // is reported in `issues()` and left out, as are frames that have no partner
-// in the other camera.
+// in the other camera. The sensor.yaml files are read by core/calib
+// (euroc_sensor_yaml.h) into one calib::BoardCalibration.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <array>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "core/calib/board_calibration.h"
 #include "core/time/time.h"
 #include "drivers/imu/imu_sample.h"
 
@@ -31,26 +32,6 @@ namespace rover::drivers {
 class DatasetError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
-};
-
-/// Pinhole + radial-tangential calibration of one camera (EuRoC sensor.yaml).
-struct CameraCalibration {
-  int width_px = 0;
-  int height_px = 0;
-  double rate_hz = 0.0;
-  std::array<double, 4> intrinsics{};  ///< fu, fv, cu, cv [px]
-  std::array<double, 4> distortion{};  ///< k1, k2, p1, p2 (radial-tangential)
-  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();  ///< EuRoC's T_BS
-};
-
-/// IMU noise figures (EuRoC sensor.yaml).
-struct ImuCalibration {
-  double rate_hz = 0.0;
-  double gyroscope_noise_density_rad_s_sqrt_hz = 0.0;
-  double gyroscope_random_walk_rad_s2_sqrt_hz = 0.0;
-  double accelerometer_noise_density_m_s2_sqrt_hz = 0.0;
-  double accelerometer_random_walk_m_s3_sqrt_hz = 0.0;
-  Eigen::Isometry3d T_body_imu = Eigen::Isometry3d::Identity();
 };
 
 /// A stereo pair: both images share one timestamp.
@@ -82,9 +63,13 @@ class EurocDataset {
   const std::vector<ImuSample>& imu() const { return imu_; }
   const std::vector<StereoFrameFiles>& stereo_frames() const { return frames_; }
   const std::vector<GroundTruthState>& ground_truth() const { return ground_truth_; }
-  const CameraCalibration& cam0() const { return cam0_; }
-  const CameraCalibration& cam1() const { return cam1_; }
-  const ImuCalibration& imu_calibration() const { return imu_calibration_; }
+  /// The dataset's calibration (imu0, cam0, cam1 sensor.yaml): always with a
+  /// stereo head, never with wheels.
+  const calib::BoardCalibration& calibration() const { return calibration_; }
+  /// Shorthands for calibration().stereo->cam0, ->cam1 and .imu.
+  const calib::CameraModel& cam0() const { return calibration_.stereo->cam0; }
+  const calib::CameraModel& cam1() const { return calibration_.stereo->cam1; }
+  const calib::ImuCalibration& imu_calibration() const { return calibration_.imu; }
   /// Things that were skipped while loading (missing images, unpaired rows).
   const std::vector<std::string>& issues() const { return issues_; }
 
@@ -98,15 +83,9 @@ class EurocDataset {
   std::vector<ImuSample> imu_;
   std::vector<StereoFrameFiles> frames_;
   std::vector<GroundTruthState> ground_truth_;
-  CameraCalibration cam0_, cam1_;
-  ImuCalibration imu_calibration_;
+  calib::BoardCalibration calibration_;
   std::vector<std::string> issues_;
 };
-
-/// Reads an EuRoC camera sensor.yaml (OpenCV FileStorage YAML).
-CameraCalibration LoadCameraCalibration(const std::string& sensor_yaml);
-/// Reads an EuRoC IMU sensor.yaml.
-ImuCalibration LoadImuCalibration(const std::string& sensor_yaml);
 
 }  // namespace rover::drivers
 

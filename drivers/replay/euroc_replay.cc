@@ -48,7 +48,7 @@ ReadStatus EurocStereoReplay::Next(StereoFrame* frame, Duration timeout) {
   if (!clock_.WaitUntilDue(files.stamp, timeout)) return ReadStatus::kTimeout;
   auto& pair = buffers_[next_ % buffers_.size()];
   const std::size_t index = next_++;
-  const CameraCalibration* calibrations[2] = {&dataset_.cam0(), &dataset_.cam1()};
+  const calib::CameraModel* calibrations[2] = {&dataset_.cam0(), &dataset_.cam1()};
   const std::string* paths[2] = {&files.cam0_path, &files.cam1_path};
   for (int i = 0; i < 2; ++i) {
     pair[static_cast<std::size_t>(i)] = cv::imread(*paths[i], cv::IMREAD_GRAYSCALE);

@@ -31,7 +31,7 @@ Eigen::Isometry3d FromRodrigues(const cv::Mat& rvec, const cv::Mat& tvec) {
 
 }  // namespace
 
-MotionEstimator::MotionEstimator(const RectifiedIntrinsics& intrinsics, double baseline_m,
+MotionEstimator::MotionEstimator(const calib::RectifiedIntrinsics& intrinsics, double baseline_m,
                                  cv::Size image_size, const MotionEstimatorOptions& options)
     : k_(intrinsics), baseline_m_(baseline_m), size_(image_size), options_(options) {}
 

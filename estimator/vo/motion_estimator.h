@@ -23,8 +23,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/calib/stereo_rectifier.h"
 #include "estimator/eskf/eskf_input.h"
-#include "estimator/vo/stereo_rectifier.h"
 
 namespace rover::estimator::vo {
 
@@ -82,8 +82,8 @@ struct MotionEstimate {
 
 class MotionEstimator {
  public:
-  MotionEstimator(const RectifiedIntrinsics& intrinsics, double baseline_m, cv::Size image_size,
-                  const MotionEstimatorOptions& options = {});
+  MotionEstimator(const calib::RectifiedIntrinsics& intrinsics, double baseline_m,
+                  cv::Size image_size, const MotionEstimatorOptions& options = {});
 
   /// Estimates T_cur_ref. Deterministic for the same input and options.
   MotionEstimate Estimate(const std::vector<StereoObservation>& observations) const;
@@ -115,7 +115,7 @@ class MotionEstimator {
   Eigen::Matrix4d ObservationWeight(const Eigen::Isometry3d& T_cur_ref,
                                     const StereoObservation& obs) const;
 
-  RectifiedIntrinsics k_;
+  calib::RectifiedIntrinsics k_;
   double baseline_m_;
   cv::Size size_;
   MotionEstimatorOptions options_;

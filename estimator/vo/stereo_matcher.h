@@ -34,7 +34,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "estimator/vo/stereo_rectifier.h"
+#include "core/calib/stereo_rectifier.h"
 
 namespace rover::estimator::vo {
 
@@ -80,7 +80,7 @@ struct StereoMatchStats {
 
 class StereoMatcher {
  public:
-  StereoMatcher(const RectifiedIntrinsics& intrinsics, double baseline_m,
+  StereoMatcher(const calib::RectifiedIntrinsics& intrinsics, double baseline_m,
                 const StereoMatcherOptions& options = {})
       : intrinsics_(intrinsics), baseline_m_(baseline_m), options_(options) {}
 
@@ -113,7 +113,7 @@ class StereoMatcher {
   const StereoMatcherOptions& options() const { return options_; }
 
  private:
-  RectifiedIntrinsics intrinsics_;
+  calib::RectifiedIntrinsics intrinsics_;
   double baseline_m_;
   StereoMatcherOptions options_;
 };

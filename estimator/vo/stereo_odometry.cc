@@ -67,24 +67,25 @@ struct StereoOdometry::Attempt {
   int with_right = 0;
 };
 
-std::optional<StereoOdometry> StereoOdometry::Create(const CameraModel& cam0,
-                                                     const CameraModel& cam1,
+std::optional<StereoOdometry> StereoOdometry::Create(const calib::CameraModel& cam0,
+                                                     const calib::CameraModel& cam1,
                                                      const StereoOdometryOptions& options,
                                                      std::string* error) {
   options.Validate();
-  std::optional<StereoRectifier> rectifier = StereoRectifier::Create(cam0, cam1, options.rectifier);
+  std::optional<calib::StereoRectifier> rectifier =
+      calib::StereoRectifier::Create(cam0, cam1, options.rectifier);
   if (!rectifier) {
     if (error != nullptr) {
       *error =
-          "unusable stereo calibration: expected two cameras of the same non-zero size, positive "
-          "focal lengths and cam1 to the right of cam0";
+          "unusable stereo calibration: expected two cameras of the same non-zero size and "
+          "distortion model, positive focal lengths and cam1 to the right of cam0";
     }
     return std::nullopt;
   }
   return StereoOdometry(*rectifier, options);
 }
 
-StereoOdometry::StereoOdometry(const StereoRectifier& rectifier,
+StereoOdometry::StereoOdometry(const calib::StereoRectifier& rectifier,
                                const StereoOdometryOptions& options)
     : rectifier_(rectifier),
       options_(options),
@@ -226,7 +227,7 @@ StereoOdometry::Attempt StereoOdometry::TrackAgainst(
   // Start each track where the guess projects it, else where it was last seen.
   std::vector<cv::Point2f> guess = kf.last_pixels;
   if (T_cur_kf_guess) {
-    const RectifiedIntrinsics& k = rectifier_.intrinsics();
+    const calib::RectifiedIntrinsics& k = rectifier_.intrinsics();
     for (size_t i = 0; i < kf.points_cam0rect.size(); ++i) {
       const Eigen::Vector3d p = *T_cur_kf_guess * kf.points_cam0rect[i];
       if (p.z() > 1e-3) {
@@ -347,7 +348,7 @@ std::optional<StereoOdometry::Attempt> StereoOdometry::TryRevisit(const Attempt&
 void StereoOdometry::RememberTracks(const Attempt& a, Keyframe* kf) const {
   // Next frame's KLT starts from here; points that were not inliers restart
   // from where the motion puts them.
-  const RectifiedIntrinsics& k = rectifier_.intrinsics();
+  const calib::RectifiedIntrinsics& k = rectifier_.intrinsics();
   for (size_t i = 0; i < kf->points_cam0rect.size(); ++i) {
     const Eigen::Vector3d p = a.motion.T_cur_ref * kf->points_cam0rect[i];
     if (p.z() > 1e-3) {
@@ -367,7 +368,7 @@ Eigen::Matrix3d StereoOdometry::PointCovariance(const Eigen::Vector3d& p,
   // p = b / d * (u - cx, (v - cy) fx / fy, fx): first-order propagation of
   // the left pixel noise (sigma_d / sqrt(2) per axis, as each image
   // contributes half of the disparity variance) and of the disparity noise.
-  const RectifiedIntrinsics& k = rectifier_.intrinsics();
+  const calib::RectifiedIntrinsics& k = rectifier_.intrinsics();
   const double b = rectifier_.baseline_m();
   const double sigma_d = options_.stereo.disparity_sigma_px;
   const double var_uv = 0.5 * sigma_d * sigma_d;

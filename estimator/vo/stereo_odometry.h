@@ -48,13 +48,13 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "core/calib/stereo_rectifier.h"
 #include "core/time/time.h"
 #include "estimator/eskf/eskf_input.h"
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/motion_estimator.h"
 #include "estimator/vo/stereo_matcher.h"
 #include "estimator/vo/stereo_odometry_options.h"
-#include "estimator/vo/stereo_rectifier.h"
 #include "estimator/vo/temporal_tracker.h"
 
 namespace rover::estimator::vo {
@@ -150,7 +150,8 @@ class StereoOdometry {
   /// Builds the rectifier and every stage. Returns nullopt with a reason in
   /// *error when the calibration is unusable. Throws std::invalid_argument
   /// for bad options.
-  static std::optional<StereoOdometry> Create(const CameraModel& cam0, const CameraModel& cam1,
+  static std::optional<StereoOdometry> Create(const calib::CameraModel& cam0,
+                                              const calib::CameraModel& cam1,
                                               const StereoOdometryOptions& options,
                                               std::string* error = nullptr);
 
@@ -165,7 +166,7 @@ class StereoOdometry {
 
   const VoHealth& health() const { return health_; }
   const StereoOdometryOptions& options() const { return options_; }
-  const StereoRectifier& rectifier() const { return rectifier_; }
+  const calib::StereoRectifier& rectifier() const { return rectifier_; }
   /// Keyframes currently held (<= max_keyframes).
   int keyframe_count() const { return static_cast<int>(keyframes_.size()); }
 
@@ -183,7 +184,7 @@ class StereoOdometry {
   };
   struct Attempt;
 
-  StereoOdometry(const StereoRectifier& rectifier, const StereoOdometryOptions& options);
+  StereoOdometry(const calib::StereoRectifier& rectifier, const StereoOdometryOptions& options);
 
   int PyramidWindowPx() const;
   /// Order, drops, image type/size and exposure; kTracked when usable.
@@ -209,7 +210,7 @@ class StereoOdometry {
   void FillQuality(const Attempt& attempt, VoFrameResult* result) const;
   void Finish(VoStatus status, std::chrono::steady_clock::time_point start, VoFrameResult* result);
 
-  StereoRectifier rectifier_;
+  calib::StereoRectifier rectifier_;
   StereoOdometryOptions options_;
   FeatureDetector detector_;
   StereoMatcher matcher_;

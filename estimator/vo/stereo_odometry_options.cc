@@ -12,7 +12,7 @@ Options LoadSection(const ConfigNode& parent, const char* key, Loader load) {
   return o;
 }
 
-void LoadRectifier(const ConfigNode& n, StereoRectifierOptions* o) {
+void LoadRectifier(const ConfigNode& n, calib::StereoRectifierOptions* o) {
   o->alpha = n.GetInRange<double>("alpha", 0.0, 1.0, o->alpha);
 }
 
@@ -126,7 +126,7 @@ void ImageCheckOptions::Validate() const {
 
 StereoOdometryOptions StereoOdometryOptions::Load(const ConfigNode& n) {
   StereoOdometryOptions o;
-  o.rectifier = LoadSection<StereoRectifierOptions>(n, "rectifier", LoadRectifier);
+  o.rectifier = LoadSection<calib::StereoRectifierOptions>(n, "rectifier", LoadRectifier);
   o.detector = LoadSection<FeatureDetectorOptions>(n, "detector", LoadDetector);
   o.stereo = LoadSection<StereoMatcherOptions>(n, "stereo", LoadStereo);
   o.tracker = LoadSection<TemporalTrackerOptions>(n, "tracker", LoadTracker);

@@ -6,11 +6,11 @@
 
 #include <string>
 
+#include "core/calib/stereo_rectifier.h"
 #include "core/config/config.h"
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/motion_estimator.h"
 #include "estimator/vo/stereo_matcher.h"
-#include "estimator/vo/stereo_rectifier.h"
 #include "estimator/vo/temporal_tracker.h"
 
 namespace rover::estimator::vo {
@@ -49,7 +49,7 @@ struct ImageCheckOptions {
 };
 
 struct StereoOdometryOptions {
-  StereoRectifierOptions rectifier;
+  calib::StereoRectifierOptions rectifier;
   /// Features at least a KLT window apart, so that no two tracks share
   /// pixels and their errors stay independent, as the covariance assumes.
   FeatureDetectorOptions detector{.cell_size_px = 40, .max_per_cell = 2, .min_distance_px = 22.0};

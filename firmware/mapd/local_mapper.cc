@@ -10,10 +10,9 @@
 namespace rover::mapd {
 namespace {
 
-estimator::vo::StereoRectifier MakeRectifier(const estimator::vo::CameraModel& cam0,
-                                             const estimator::vo::CameraModel& cam1) {
-  std::optional<estimator::vo::StereoRectifier> r =
-      estimator::vo::StereoRectifier::Create(cam0, cam1);
+calib::StereoRectifier MakeRectifier(const calib::CameraModel& cam0,
+                                     const calib::CameraModel& cam1) {
+  std::optional<calib::StereoRectifier> r = calib::StereoRectifier::Create(cam0, cam1);
   if (!r) {
     throw std::invalid_argument(
         "LocalMapper: the stereo calibration is unusable (sizes differ or are zero, focal "
@@ -22,7 +21,7 @@ estimator::vo::StereoRectifier MakeRectifier(const estimator::vo::CameraModel& c
   return *std::move(r);
 }
 
-mapping::RectifiedStereo StereoOf(const estimator::vo::StereoRectifier& r) {
+mapping::RectifiedStereo StereoOf(const calib::StereoRectifier& r) {
   mapping::RectifiedStereo s;
   s.width_px = r.image_size().width;
   s.height_px = r.image_size().height;
@@ -59,8 +58,8 @@ void LocalMapperOptions::Validate() const {
   traversability.Validate();
 }
 
-LocalMapper::LocalMapper(const LocalMapperOptions& options, const estimator::vo::CameraModel& cam0,
-                         const estimator::vo::CameraModel& cam1)
+LocalMapper::LocalMapper(const LocalMapperOptions& options, const calib::CameraModel& cam0,
+                         const calib::CameraModel& cam1)
     : options_((options.Validate(), options)),
       rectifier_(MakeRectifier(cam0, cam1)),
       stereo_(StereoOf(rectifier_)),

@@ -13,7 +13,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "estimator/vo/stereo_rectifier.h"
+#include "core/calib/stereo_rectifier.h"
 #include "mapping/depth/depth_image.h"
 #include "mapping/depth/disparity_estimator.h"
 #include "mapping/depth/stereo_error_model.h"
@@ -58,8 +58,8 @@ class LocalMapper {
  public:
   /// Rectification from the two cameras' calibration. Throws
   /// std::invalid_argument if it is unusable or the options are invalid.
-  LocalMapper(const LocalMapperOptions& options, const estimator::vo::CameraModel& cam0,
-              const estimator::vo::CameraModel& cam1);
+  LocalMapper(const LocalMapperOptions& options, const calib::CameraModel& cam0,
+              const calib::CameraModel& cam1);
 
   /// Maps one raw mono8 pair taken at body pose `T_local_body` into
   /// `submap` (which lives in the same local frame). Throws
@@ -86,7 +86,7 @@ class LocalMapper {
                     const Eigen::Isometry3d& T_local_cam);
 
   LocalMapperOptions options_;
-  estimator::vo::StereoRectifier rectifier_;
+  calib::StereoRectifier rectifier_;
   mapping::RectifiedStereo stereo_;
   mapping::StereoErrorModel error_model_;
   mapping::DisparityEstimator disparity_;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 #include <opencv2/core.hpp>
 
@@ -46,10 +47,22 @@ std::unique_ptr<ipc::Publisher<T>> Advertise(ipc::Transport* transport, std::str
   return p;
 }
 
-estimator::vo::CameraModel CameraOf(const topics::CameraCalibrationMsg& m) {
-  estimator::vo::CameraModel c;
+// Throws std::invalid_argument for a distortion model this build does not
+// know; TakeCalibration reports it and does not map.
+calib::CameraModel CameraOf(const topics::CameraCalibrationMsg& m) {
+  calib::CameraModel c;
   c.width_px = m.width_px;
   c.height_px = m.height_px;
+  if (m.distortion_model == topics::kDistortionRadialTangential) {
+    c.distortion_model = calib::DistortionModel::kRadialTangential;
+  } else if (m.distortion_model == topics::kDistortionEquidistant) {
+    c.distortion_model = calib::DistortionModel::kEquidistant;
+  } else {
+    throw std::invalid_argument(
+        "expected distortion_model " + std::to_string(topics::kDistortionRadialTangential) +
+        " (radial-tangential) or " + std::to_string(topics::kDistortionEquidistant) +
+        " (equidistant), found " + std::to_string(m.distortion_model));
+  }
   c.intrinsics = m.intrinsics;
   c.distortion = m.distortion;
   const Eigen::Quaterniond q(m.q_body_cam_wxyz[0], m.q_body_cam_wxyz[1], m.q_body_cam_wxyz[2],

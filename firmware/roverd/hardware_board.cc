@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/calib/board_calibration.h"
+#include "core/calib/euroc_sensor_yaml.h"
 #include "drivers/camera/aravis_camera.h"
 #include "drivers/camera/stereo_pairer.h"
 #include "drivers/camera/v4l2_camera.h"
@@ -13,7 +15,6 @@
 #include "drivers/imu/adis16448_driver.h"
 #include "drivers/imu/spidev_device.h"
 #include "drivers/imu/xsens_mti_driver.h"
-#include "drivers/replay/euroc_dataset.h"
 #include "firmware/roverd/sensor_calibration.h"
 
 namespace rover::roverd {
@@ -39,11 +40,10 @@ std::string SensorYaml(const std::string& folder, const std::string& sensor) {
 
 /// A camera's calibration, which must be for the image size the camera is
 /// set to: the intrinsics of another size would be silently wrong.
-drivers::CameraCalibration CameraCalibrationFor(const std::string& folder,
-                                                const std::string& sensor,
-                                                const runtime::BoardCameraOptions& camera) {
+calib::CameraModel CameraCalibrationFor(const std::string& folder, const std::string& sensor,
+                                        const runtime::BoardCameraOptions& camera) {
   const std::string path = SensorYaml(folder, sensor);
-  drivers::CameraCalibration c = drivers::LoadCameraCalibration(path);
+  calib::CameraModel c = calib::LoadEurocCamera(path);
   if (c.width_px != camera.width_px || c.height_px != camera.height_px) {
     throw std::invalid_argument(
         "hardware.camera.width_px: " + path + " calibrates " + sensor + " at " +
@@ -94,17 +94,16 @@ HardwareBoard::HardwareBoard(const runtime::BoardHardwareOptions& options) {
   if (auto problem = options.Problem()) {
     throw std::invalid_argument(problem->first + ": " + problem->second);
   }
-  const drivers::ImuCalibration imu =
-      drivers::LoadImuCalibration(SensorYaml(options.calibration, "imu0"));
+  const calib::ImuCalibration imu = calib::LoadEurocImu(SensorYaml(options.calibration, "imu0"));
   options_.estimator = FilterOptionsFromCalibration(imu, options.estimator_config);
   options_.estimator.imu.rate_hz = options.imu.rate_hz;
   if (options.camera) {
-    const Eigen::Isometry3d T_imu_body = imu.T_body_imu.inverse();
     CameraSetup head;
-    head.cam0 = ToCameraModel(CameraCalibrationFor(options.calibration, "cam0", *options.camera),
-                              T_imu_body);
-    head.cam1 = ToCameraModel(CameraCalibrationFor(options.calibration, "cam1", *options.camera),
-                              T_imu_body);
+    // The filter's body is the IMU frame.
+    head.cam0 = calib::CameraInImuFrame(
+        CameraCalibrationFor(options.calibration, "cam0", *options.camera), imu);
+    head.cam1 = calib::CameraInImuFrame(
+        CameraCalibrationFor(options.calibration, "cam1", *options.camera), imu);
     if (!options.vo_config.empty()) {
       head.vo = estimator::vo::StereoOdometryOptions::LoadFile(options.vo_config);
     }

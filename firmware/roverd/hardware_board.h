@@ -33,8 +33,8 @@ namespace rover::roverd {
 class HardwareBoard {
  public:
   /// Loads the calibration and opens every device of `options`. Throws
-  /// (drivers' errors, ConfigError, std::invalid_argument) naming the
-  /// device or file and the problem.
+  /// (drivers' errors, calib::CalibrationError, ConfigError,
+  /// std::invalid_argument) naming the device or file and the problem.
   explicit HardwareBoard(const runtime::BoardHardwareOptions& options);
   ~HardwareBoard();
   HardwareBoard(const HardwareBoard&) = delete;

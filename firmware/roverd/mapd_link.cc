@@ -36,10 +36,13 @@ void CopyPacked(const drivers::ImageView& view, uint8_t* dst) {
   }
 }
 
-topics::CameraCalibrationMsg ToCameraMsg(const estimator::vo::CameraModel& cam) {
+topics::CameraCalibrationMsg ToCameraMsg(const calib::CameraModel& cam) {
   topics::CameraCalibrationMsg m;
   m.width_px = cam.width_px;
   m.height_px = cam.height_px;
+  m.distortion_model = cam.distortion_model == calib::DistortionModel::kEquidistant
+                           ? topics::kDistortionEquidistant
+                           : topics::kDistortionRadialTangential;
   m.intrinsics = cam.intrinsics;
   m.distortion = cam.distortion;
   const Eigen::Vector3d p = cam.T_body_cam.translation();
@@ -51,8 +54,8 @@ topics::CameraCalibrationMsg ToCameraMsg(const estimator::vo::CameraModel& cam) 
 
 }  // namespace
 
-topics::StereoCalibrationMsg ToCalibrationMsg(const estimator::vo::CameraModel& cam0,
-                                              const estimator::vo::CameraModel& cam1) {
+topics::StereoCalibrationMsg ToCalibrationMsg(const calib::CameraModel& cam0,
+                                              const calib::CameraModel& cam1) {
   topics::StereoCalibrationMsg m;
   m.cam0 = ToCameraMsg(cam0);
   m.cam1 = ToCameraMsg(cam1);

@@ -17,10 +17,10 @@
 #include <memory>
 #include <optional>
 
+#include "core/calib/camera_model.h"
 #include "core/ipc/transport.h"
 #include "core/log/msgs/diagnostic_msgs.h"
 #include "drivers/camera/stereo_frame.h"
-#include "estimator/vo/stereo_rectifier.h"
 #include "firmware/roverd/estimator_loop.h"
 #include "firmware/runtime/topics/rover_topics.h"
 
@@ -82,8 +82,8 @@ class MapdLink final : public EstimatorListener {
 };
 
 /// The calibration message of a stereo head.
-runtime::topics::StereoCalibrationMsg ToCalibrationMsg(const estimator::vo::CameraModel& cam0,
-                                                       const estimator::vo::CameraModel& cam1);
+runtime::topics::StereoCalibrationMsg ToCalibrationMsg(const calib::CameraModel& cam0,
+                                                       const calib::CameraModel& cam1);
 
 /// Forwards the estimator's outputs to two listeners (either may be null).
 class ListenerPair final : public EstimatorListener {

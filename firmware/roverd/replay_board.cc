@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "core/calib/board_calibration.h"
 #include "firmware/roverd/sensor_calibration.h"
 
 namespace rover::roverd {
@@ -21,10 +22,10 @@ ReplayBoard::ReplayBoard(const runtime::BoardReplayOptions& options)
   options_.lockstep = options.lockstep;
   options_.estimator =
       FilterOptionsFromCalibration(dataset_.imu_calibration(), options.estimator_config);
-  const Eigen::Isometry3d T_imu_body = dataset_.imu_calibration().T_body_imu.inverse();
   CameraSetup head;
-  head.cam0 = ToCameraModel(dataset_.cam0(), T_imu_body);
-  head.cam1 = ToCameraModel(dataset_.cam1(), T_imu_body);
+  // The filter's body is the IMU frame.
+  head.cam0 = calib::CameraInImuFrame(dataset_.cam0(), dataset_.imu_calibration());
+  head.cam1 = calib::CameraInImuFrame(dataset_.cam1(), dataset_.imu_calibration());
   if (!options.vo_config.empty()) {
     head.vo = estimator::vo::StereoOdometryOptions::LoadFile(options.vo_config);
   } else if (dataset_.cam0().rate_hz > 0.0) {

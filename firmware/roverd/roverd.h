@@ -21,6 +21,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/calib/camera_model.h"
 #include "core/log/msgs/diagnostic_msgs.h"
 #include "core/ring/spsc_ring.h"
 #include "drivers/camera/camera_trigger.h"
@@ -47,8 +48,8 @@ namespace rover::roverd {
 
 /// The stereo head: calibration and VO options (absent: no VO).
 struct CameraSetup {
-  estimator::vo::CameraModel cam0;
-  estimator::vo::CameraModel cam1;
+  calib::CameraModel cam0;
+  calib::CameraModel cam1;
   estimator::vo::StereoOdometryOptions vo;
 };
 

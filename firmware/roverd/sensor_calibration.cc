@@ -2,18 +2,7 @@
 
 namespace rover::roverd {
 
-estimator::vo::CameraModel ToCameraModel(const drivers::CameraCalibration& c,
-                                         const Eigen::Isometry3d& T_imu_body) {
-  estimator::vo::CameraModel m;
-  m.width_px = c.width_px;
-  m.height_px = c.height_px;
-  m.intrinsics = c.intrinsics;
-  m.distortion = c.distortion;
-  m.T_body_cam = T_imu_body * c.T_body_cam;  // the filter's body is the IMU frame
-  return m;
-}
-
-estimator::EskfOptions FilterOptionsFromCalibration(const drivers::ImuCalibration& imu,
+estimator::EskfOptions FilterOptionsFromCalibration(const calib::ImuCalibration& imu,
                                                     const std::string& path) {
   // A given file is complete (absent keys take the defaults); without one the
   // dataset's own noise figures are the best knowledge.
@@ -25,10 +14,10 @@ estimator::EskfOptions FilterOptionsFromCalibration(const drivers::ImuCalibratio
     const auto set = [](double v, double* option) {
       if (v > 0.0) *option = v;
     };
-    set(imu.gyroscope_noise_density_rad_s_sqrt_hz, &o.imu.gyro_noise_density_rad_s_sqrt_hz);
-    set(imu.gyroscope_random_walk_rad_s2_sqrt_hz, &o.imu.gyro_bias_random_walk_rad_s2_sqrt_hz);
-    set(imu.accelerometer_noise_density_m_s2_sqrt_hz, &o.imu.accel_noise_density_m_s2_sqrt_hz);
-    set(imu.accelerometer_random_walk_m_s3_sqrt_hz, &o.imu.accel_bias_random_walk_m_s3_sqrt_hz);
+    set(imu.gyro_noise_density_rad_s_sqrt_hz, &o.imu.gyro_noise_density_rad_s_sqrt_hz);
+    set(imu.gyro_random_walk_rad_s2_sqrt_hz, &o.imu.gyro_bias_random_walk_rad_s2_sqrt_hz);
+    set(imu.accel_noise_density_m_s2_sqrt_hz, &o.imu.accel_noise_density_m_s2_sqrt_hz);
+    set(imu.accel_random_walk_m_s3_sqrt_hz, &o.imu.accel_bias_random_walk_m_s3_sqrt_hz);
     o.wheels.enabled = false;  // no wheel drives are replayed
   }
   o.clones.max_clones = estimator::kMaxClones;  // 5 keyframes + frames in flight

@@ -24,7 +24,7 @@
 namespace rover::runtime::topics {
 
 /// Bumped whenever a message below changes layout or meaning.
-inline constexpr uint32_t kTopicsVersion = 1;
+inline constexpr uint32_t kTopicsVersion = 2;
 
 inline constexpr std::string_view kPoseTopic = "/roverd/pose";
 inline constexpr std::string_view kStereoFrameTopic = "/roverd/stereo_frame";
@@ -148,13 +148,19 @@ struct TraversabilityMsg {
   std::array<std::byte, kMaxCdrBytes> cdr;
 };
 
-/// One camera's calibration as roverd uses it: pinhole with radial-tangential
-/// distortion, and its pose on the body (the IMU).
+/// CameraCalibrationMsg::distortion_model values (calib::DistortionModel).
+inline constexpr int32_t kDistortionRadialTangential = 0;  ///< k1, k2, p1, p2
+inline constexpr int32_t kDistortionEquidistant = 1;       ///< k1, k2, k3, k4 (fisheye)
+
+/// One camera's calibration as roverd uses it: pinhole with the lens model
+/// `distortion_model`, and its pose on the body (the IMU).
 struct CameraCalibrationMsg {
   int32_t width_px = 0;
   int32_t height_px = 0;
+  int32_t distortion_model = kDistortionRadialTangential;
+  int32_t reserved = 0;                ///< keeps the doubles 8-byte aligned
   std::array<double, 4> intrinsics{};  ///< fu, fv, cu, cv [px]
-  std::array<double, 4> distortion{};  ///< k1, k2, p1, p2
+  std::array<double, 4> distortion{};  ///< coefficients of distortion_model
   std::array<double, 3> p_body_cam_m{};
   std::array<double, 4> q_body_cam_wxyz{1.0, 0.0, 0.0, 0.0};
 };

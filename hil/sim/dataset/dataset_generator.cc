@@ -16,19 +16,19 @@
 namespace rover::sim {
 namespace {
 
-drivers::ImuCalibration ImuCalibrationOf(const ImuModelOptions& imu) {
-  drivers::ImuCalibration c;
+calib::ImuCalibration ImuCalibrationOf(const ImuModelOptions& imu) {
+  calib::ImuCalibration c;
   c.rate_hz = imu.rate_hz;
-  c.gyroscope_noise_density_rad_s_sqrt_hz = imu.gyro.noise_density;
-  c.gyroscope_random_walk_rad_s2_sqrt_hz = imu.gyro.bias_random_walk;
-  c.accelerometer_noise_density_m_s2_sqrt_hz = imu.accel.noise_density;
-  c.accelerometer_random_walk_m_s3_sqrt_hz = imu.accel.bias_random_walk;
+  c.gyro_noise_density_rad_s_sqrt_hz = imu.gyro.noise_density;
+  c.gyro_random_walk_rad_s2_sqrt_hz = imu.gyro.bias_random_walk;
+  c.accel_noise_density_m_s2_sqrt_hz = imu.accel.noise_density;
+  c.accel_random_walk_m_s3_sqrt_hz = imu.accel.bias_random_walk;
   return c;  // the body frame is the IMU frame: T_BS = identity
 }
 
-drivers::CameraCalibration CameraCalibrationOf(const StereoCameraOptions& cam,
-                                               const Eigen::Isometry3d& T_body_cam) {
-  drivers::CameraCalibration c;
+calib::CameraModel CameraCalibrationOf(const StereoCameraOptions& cam,
+                                       const Eigen::Isometry3d& T_body_cam) {
+  calib::CameraModel c;
   c.width_px = cam.width_px;
   c.height_px = cam.height_px;
   c.rate_hz = cam.rate_hz;

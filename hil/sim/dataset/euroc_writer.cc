@@ -99,26 +99,27 @@ EurocWriter::~EurocWriter() {
   }
 }
 
-void EurocWriter::WriteImuCalibration(const drivers::ImuCalibration& c) {
+void EurocWriter::WriteImuCalibration(const calib::ImuCalibration& c) {
   WriteText(files_->mav0 / "imu0/sensor.yaml",
             "%YAML:1.0\nsensor_type: imu\ncomment: rover-sim IMU\n" + TbsYaml(c.T_body_imu) +
                 "rate_hz: " + Num(c.rate_hz) + "\n" + "gyroscope_noise_density: " +
-                Num(c.gyroscope_noise_density_rad_s_sqrt_hz) + "     # [ rad / s / sqrt(Hz) ]\n" +
-                "gyroscope_random_walk: " + Num(c.gyroscope_random_walk_rad_s2_sqrt_hz) +
+                Num(c.gyro_noise_density_rad_s_sqrt_hz) + "     # [ rad / s / sqrt(Hz) ]\n" +
+                "gyroscope_random_walk: " + Num(c.gyro_random_walk_rad_s2_sqrt_hz) +
                 "       # [ rad / s^2 / sqrt(Hz) ]\n" + "accelerometer_noise_density: " +
-                Num(c.accelerometer_noise_density_m_s2_sqrt_hz) + "  # [ m / s^2 / sqrt(Hz) ]\n" +
-                "accelerometer_random_walk: " + Num(c.accelerometer_random_walk_m_s3_sqrt_hz) +
+                Num(c.accel_noise_density_m_s2_sqrt_hz) + "  # [ m / s^2 / sqrt(Hz) ]\n" +
+                "accelerometer_random_walk: " + Num(c.accel_random_walk_m_s3_sqrt_hz) +
                 "    # [ m / s^3 / sqrt(Hz) ]\n");
 }
 
-void EurocWriter::WriteCameraCalibration(int index, const drivers::CameraCalibration& c) {
+void EurocWriter::WriteCameraCalibration(int index, const calib::CameraModel& c) {
   const std::string yaml =
       "%YAML:1.0\nsensor_type: camera\ncomment: rover-sim cam" + std::to_string(index) + "\n" +
       TbsYaml(c.T_body_cam) + "rate_hz: " + Num(c.rate_hz) + "\nresolution: [" +
       std::to_string(c.width_px) + ", " + std::to_string(c.height_px) +
       "]\ncamera_model: pinhole\nintrinsics: [" + Num(c.intrinsics[0]) + ", " +
       Num(c.intrinsics[1]) + ", " + Num(c.intrinsics[2]) + ", " + Num(c.intrinsics[3]) +
-      "] #fu, fv, cu, cv\ndistortion_model: radial-tangential\ndistortion_coefficients: [" +
+      "] #fu, fv, cu, cv\ndistortion_model: " +
+      std::string(calib::EurocDistortionName(c.distortion_model)) + "\ndistortion_coefficients: [" +
       Num(c.distortion[0]) + ", " + Num(c.distortion[1]) + ", " + Num(c.distortion[2]) + ", " +
       Num(c.distortion[3]) + "]\n";
   WriteText(files_->mav0 / ("cam" + std::to_string(index)) / "sensor.yaml", yaml);

@@ -23,6 +23,8 @@
 #include <memory>
 #include <string>
 
+#include "core/calib/camera_model.h"
+#include "core/calib/imu_calibration.h"
 #include "drivers/can/can_frame.h"
 #include "drivers/gpio/gpio_edge.h"
 #include "drivers/imu/imu_sample.h"
@@ -45,9 +47,9 @@ class EurocWriter {
   explicit EurocWriter(const std::string& dir);
   ~EurocWriter();
 
-  void WriteImuCalibration(const drivers::ImuCalibration& calibration);
+  void WriteImuCalibration(const calib::ImuCalibration& calibration);
   /// `index` 0 or 1.
-  void WriteCameraCalibration(int index, const drivers::CameraCalibration& calibration);
+  void WriteCameraCalibration(int index, const calib::CameraModel& calibration);
 
   void AddImu(const drivers::ImuSample& sample);
   /// 8-bit mono images of one trigger.

@@ -122,9 +122,9 @@ std::string Fixed(double v, int digits) {
 
 }  // namespace
 
-estimator::vo::CameraModel CameraModelOf(const StereoCameraOptions& cam,
-                                         const Eigen::Isometry3d& T_body_cam) {
-  estimator::vo::CameraModel m;
+calib::CameraModel CameraModelOf(const StereoCameraOptions& cam,
+                                 const Eigen::Isometry3d& T_body_cam) {
+  calib::CameraModel m;
   m.width_px = cam.width_px;
   m.height_px = cam.height_px;
   m.intrinsics = {cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px};

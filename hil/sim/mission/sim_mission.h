@@ -11,6 +11,7 @@
 
 #include <optional>
 
+#include "core/calib/camera_model.h"
 #include "firmware/roverd/roverd.h"
 #include "firmware/runtime/board/board_config.h"
 #include "hil/sim/render/stereo_camera.h"
@@ -70,8 +71,8 @@ void PrintMissionSummary(const MissionResult& result, std::ostream& out);
 
 /// The calibration roverd (and mapd, through roverd) uses for one of the
 /// simulator's cameras at `T_body_cam`.
-estimator::vo::CameraModel CameraModelOf(const StereoCameraOptions& camera,
-                                         const Eigen::Isometry3d& T_body_cam);
+calib::CameraModel CameraModelOf(const StereoCameraOptions& camera,
+                                 const Eigen::Isometry3d& T_body_cam);
 
 }  // namespace rover::sim
 

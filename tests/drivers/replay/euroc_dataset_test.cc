@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/calib/euroc_sensor_yaml.h"
 #include "drivers/replay/euroc_replay.h"
 #include "tests/support/temp_dir.h"
 
@@ -36,7 +37,10 @@ TEST(EurocDatasetTest, LoadsTheRealMicroExcerpt) {
   const double baseline =
       (d.cam0().T_body_cam.translation() - d.cam1().T_body_cam.translation()).norm();
   EXPECT_NEAR(baseline, 0.110, 0.002);
-  EXPECT_DOUBLE_EQ(d.imu_calibration().gyroscope_noise_density_rad_s_sqrt_hz, 1.6968e-04);
+  EXPECT_DOUBLE_EQ(d.imu_calibration().gyro_noise_density_rad_s_sqrt_hz, 1.6968e-04);
+  // One calibration, as core/calib reads the sensor.yaml files.
+  EXPECT_EQ(d.calibration(), calib::LoadEurocCalibration(MicroEuroc() + "/mav0"));
+  EXPECT_FALSE(d.calibration().wheels.has_value());
   EXPECT_TRUE(d.ground_truth().empty());
   // The 4 cam1 rows without images are reported, not silently lost.
   bool reported_missing = false;
@@ -133,6 +137,20 @@ TEST_F(DamagedDatasetTest, NanAndShortRowsAreErrors) {
   EXPECT_THROW(EurocDataset::Load(dir_.path().string()), DatasetError);
   WriteImu("100,0,0\n");
   EXPECT_THROW(EurocDataset::Load(dir_.path().string()), DatasetError);
+}
+
+TEST_F(DamagedDatasetTest, BadCalibrationIsADatasetErrorNamingTheFile) {
+  WriteImu("100,0,0,0,0,0,9.8\n");
+  std::ofstream(dir_.path() / "mav0/cam1/sensor.yaml")
+      << "%YAML:1.0\nresolution: [752, 480]\nrate_hz: 20\ncamera_model: pinhole\n"
+         "distortion_model: fov\n";
+  try {
+    EurocDataset::Load(dir_.path().string());
+    FAIL() << "expected DatasetError";
+  } catch (const DatasetError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("cam1/sensor.yaml: expected camera_model pinhole"));
+    EXPECT_THAT(e.what(), HasSubstr("'fov'"));
+  }
 }
 
 TEST(EurocDatasetErrorTest, NotADataset) {

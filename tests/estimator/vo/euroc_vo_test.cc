@@ -11,19 +11,17 @@
 #include <string>
 #include <vector>
 
+#include "core/calib/stereo_rectifier.h"
 #include "core/geometry/so3.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/motion_estimator.h"
 #include "estimator/vo/stereo_matcher.h"
-#include "estimator/vo/stereo_rectifier.h"
 #include "estimator/vo/temporal_tracker.h"
 #include "tests/estimator/vo/euroc_vo_util.h"
 
 namespace rover::estimator::vo {
 namespace {
-
-using testing::ToModel;
 
 using Clock = std::chrono::steady_clock;
 
@@ -38,7 +36,7 @@ class EurocVoTest : public ::testing::Test {
     const std::string dir =
         std::string(shared != nullptr ? shared : "../shared") + "/data/euroc_v1_01_micro";
     dataset_ = drivers::EurocDataset::Load(dir, dir + "/groundtruth/V1_01_easy_openvins.csv");
-    auto rect = StereoRectifier::Create(ToModel(dataset_.cam0()), ToModel(dataset_.cam1()));
+    auto rect = calib::StereoRectifier::Create(dataset_.cam0(), dataset_.cam1());
     ASSERT_TRUE(rect.has_value());
     rectifier_ = std::move(*rect);
   }
@@ -52,7 +50,7 @@ class EurocVoTest : public ::testing::Test {
 
   void RunPair(size_t ref, size_t cur);
   drivers::EurocDataset dataset_;
-  std::optional<StereoRectifier> rectifier_;
+  std::optional<calib::StereoRectifier> rectifier_;
 };
 
 TEST_F(EurocVoTest, StereoMatchingFindsPlausibleDepths) {

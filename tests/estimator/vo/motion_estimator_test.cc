@@ -12,7 +12,7 @@
 namespace rover::estimator::vo {
 namespace {
 
-constexpr RectifiedIntrinsics kK{450.0, 450.0, 376.0, 240.0};
+constexpr calib::RectifiedIntrinsics kK{450.0, 450.0, 376.0, 240.0};
 constexpr double kBaseline = 0.11;
 const cv::Size kSize(752, 480);
 

@@ -10,17 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "core/calib/stereo_rectifier.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimator/vo/feature_detector.h"
 #include "estimator/vo/stereo_matcher.h"
-#include "estimator/vo/stereo_rectifier.h"
 #include "tests/estimator/vo/euroc_vo_util.h"
 #include "tests/estimator/vo/stereo_matcher_reference.h"
 
 namespace rover::estimator::vo {
 namespace {
-
-using testing::ToModel;
 
 // Points of `a` that `b` accepted too, with the right pixel within `tolerance_px`.
 int Same(const std::vector<StereoPoint>& a, const std::vector<StereoPoint>& b, float tolerance_px) {
@@ -42,7 +40,7 @@ TEST(StereoMatcherEurocTest, AgreesWithTheExhaustiveSearch) {
   const std::string dir =
       std::string(shared != nullptr ? shared : "../shared") + "/data/euroc_v1_01_micro";
   const auto dataset = drivers::EurocDataset::Load(dir);
-  const auto rectifier = StereoRectifier::Create(ToModel(dataset.cam0()), ToModel(dataset.cam1()));
+  const auto rectifier = calib::StereoRectifier::Create(dataset.cam0(), dataset.cam1());
   ASSERT_TRUE(rectifier.has_value());
   const StereoMatcher matcher(rectifier->intrinsics(), rectifier->baseline_m());
   for (const size_t frame : {0u, 40u, 80u}) {

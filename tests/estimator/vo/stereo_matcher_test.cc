@@ -15,7 +15,7 @@
 namespace rover::estimator::vo {
 namespace {
 
-constexpr RectifiedIntrinsics kIntrinsics{400.0, 400.0, 320.0, 240.0};
+constexpr calib::RectifiedIntrinsics kIntrinsics{400.0, 400.0, 320.0, 240.0};
 constexpr double kBaseline = 0.12;
 
 // A fronto-parallel textured plane: the right image is the left one shifted

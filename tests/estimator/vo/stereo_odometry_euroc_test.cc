@@ -23,7 +23,6 @@ namespace rover::estimator::vo {
 namespace {
 
 using testing::Pose;
-using testing::ToModel;
 
 class StereoOdometryEurocTest : public ::testing::Test {
  protected:
@@ -51,8 +50,7 @@ class StereoOdometryEurocTest : public ::testing::Test {
     StereoOdometryOptions options;
     options.checks.nominal_rate_hz = dataset_->cam0().rate_hz;
     std::string error;
-    auto vo = StereoOdometry::Create(ToModel(dataset_->cam0()), ToModel(dataset_->cam1()), options,
-                                     &error);
+    auto vo = StereoOdometry::Create(dataset_->cam0(), dataset_->cam1(), options, &error);
     EXPECT_TRUE(vo.has_value()) << error;
     return std::move(*vo);
   }
@@ -225,8 +223,7 @@ TEST_F(StereoOdometryEurocTest, ComingBackRevisitsOlderKeyframes) {
   options.keyframes.max_translation_m = 0.0004;
   options.keyframes.max_rotation_rad = 0.0015;
   std::string error;
-  auto vo =
-      StereoOdometry::Create(ToModel(dataset_->cam0()), ToModel(dataset_->cam1()), options, &error);
+  auto vo = StereoOdometry::Create(dataset_->cam0(), dataset_->cam1(), options, &error);
   ASSERT_TRUE(vo.has_value()) << error;
   const std::vector<StereoImages>& f = *frames_;
   std::vector<size_t> order;

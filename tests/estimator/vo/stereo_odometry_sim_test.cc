@@ -24,7 +24,6 @@ namespace rover::estimator::vo {
 namespace {
 
 using testing::Pose;
-using testing::ToModel;
 
 struct RunFigures {
   int frames = 0;
@@ -43,7 +42,7 @@ RunFigures RunVo(const drivers::EurocDataset& d) {
     options = StereoOdometryOptions::LoadFile(config);
   options.checks.nominal_rate_hz = d.cam0().rate_hz;
   std::string error;
-  auto vo = StereoOdometry::Create(ToModel(d.cam0()), ToModel(d.cam1()), options, &error);
+  auto vo = StereoOdometry::Create(d.cam0(), d.cam1(), options, &error);
   EXPECT_TRUE(vo.has_value()) << error;
   RunFigures fig;
   double nees_sum = 0.0;

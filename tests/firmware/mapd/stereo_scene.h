@@ -13,7 +13,7 @@
 
 #include <Eigen/Geometry>
 
-#include "estimator/vo/stereo_rectifier.h"
+#include "core/calib/stereo_rectifier.h"
 
 namespace rover::mapd::testing {
 
@@ -31,8 +31,8 @@ struct StereoScene {
 
   /// cam0 on the body: 0.2 m ahead, looking along body x, pitched down 25
   /// deg (OpenCV axes: x right, y down, z forward).
-  estimator::vo::CameraModel Camera(int index) const {
-    estimator::vo::CameraModel c;
+  calib::CameraModel Camera(int index) const {
+    calib::CameraModel c;
     c.width_px = width_px;
     c.height_px = height_px;
     c.intrinsics = {focal_px, focal_px, width_px / 2.0, height_px / 2.0};
@@ -90,7 +90,7 @@ struct StereoScene {
   /// Renders camera `index` at body pose T_local_body into `out` (packed
   /// mono8 rows).
   void Render(int index, const Eigen::Isometry3d& T_local_body, uint8_t* out) const {
-    const estimator::vo::CameraModel cam = Camera(index);
+    const calib::CameraModel cam = Camera(index);
     const Eigen::Isometry3d T_local_cam = T_local_body * cam.T_body_cam;
     for (int v = 0; v < height_px; ++v) {
       for (int u = 0; u < width_px; ++u) {

@@ -144,5 +144,28 @@ TEST_F(MapdLinkTest, HandsRequestsToTheLoopStampedAtTheNewestEstimate) {
   EXPECT_EQ(loop.stats().late_inputs, 0u);
 }
 
+// The calibration message carries each camera's lens model, so that mapd
+// rectifies a fisheye head as one.
+TEST(CalibrationMsgTest, CarriesTheDistortionModelAndThePose) {
+  calib::CameraModel cam0;
+  cam0.width_px = 752;
+  cam0.height_px = 480;
+  cam0.intrinsics = {458.0, 457.0, 367.0, 248.0};
+  cam0.distortion = {-0.28, 0.07, 2e-4, 2e-5};
+  cam0.T_body_cam.translation() = Eigen::Vector3d(0.1, -0.05, 0.02);
+  calib::CameraModel cam1 = cam0;
+  cam1.distortion_model = calib::DistortionModel::kEquidistant;
+  cam1.distortion = {0.0034, 0.0007, -0.0021, 0.0002};
+  const topics::StereoCalibrationMsg m = ToCalibrationMsg(cam0, cam1);
+  EXPECT_EQ(m.version, topics::kTopicsVersion);
+  EXPECT_EQ(m.cam0.distortion_model, topics::kDistortionRadialTangential);
+  EXPECT_EQ(m.cam1.distortion_model, topics::kDistortionEquidistant);
+  EXPECT_EQ(m.cam1.distortion, cam1.distortion);
+  EXPECT_EQ(m.cam0.width_px, 752);
+  EXPECT_EQ(m.cam0.intrinsics, cam0.intrinsics);
+  EXPECT_EQ(m.cam0.p_body_cam_m[0], 0.1);
+  EXPECT_EQ(m.cam0.q_body_cam_wxyz[0], 1.0);
+}
+
 }  // namespace
 }  // namespace rover::roverd

@@ -118,8 +118,8 @@ class ScriptedCan final : public drivers::CanBus {
   int in_period_ = 0;
 };
 
-estimator::vo::CameraModel Camera(double x_m) {
-  estimator::vo::CameraModel c;
+calib::CameraModel Camera(double x_m) {
+  calib::CameraModel c;
   c.width_px = 376;
   c.height_px = 240;
   c.intrinsics = {230.0, 230.0, 188.0, 120.0};

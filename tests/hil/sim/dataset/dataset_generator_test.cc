@@ -65,7 +65,7 @@ TEST(DatasetGeneratorTest, OurEurocReaderReadsTheDataset) {
   EXPECT_EQ(d.cam0().intrinsics[0], s.camera.fx_px);
   EXPECT_EQ(d.cam0().distortion[0], s.camera.k1);
   EXPECT_TRUE(d.cam1().T_body_cam.isApprox(s.camera.T_body_cam1(), 1e-12));
-  EXPECT_EQ(d.imu_calibration().gyroscope_noise_density_rad_s_sqrt_hz, s.imu.gyro.noise_density);
+  EXPECT_EQ(d.imu_calibration().gyro_noise_density_rad_s_sqrt_hz, s.imu.gyro.noise_density);
   EXPECT_TRUE(fs::exists(dir.path() / "world/heightfield.bin"));
   EXPECT_TRUE(fs::exists(dir.path() / "world/tags.csv"));
 }

@@ -8,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "core/calib/euroc_sensor_yaml.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "tests/support/temp_dir.h"
 
@@ -16,8 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-drivers::CameraCalibration Camera(double x) {
-  drivers::CameraCalibration c;
+calib::CameraModel Camera(double x) {
+  calib::CameraModel c;
   c.width_px = 64;
   c.height_px = 48;
   c.rate_hz = 20;
@@ -41,12 +42,12 @@ Written WriteDataset(const std::string& dir) {
   std::uniform_real_distribution<double> u(-1, 1);
   Written w;
   EurocWriter writer(dir);
-  drivers::ImuCalibration imu_cal;
+  calib::ImuCalibration imu_cal;
   imu_cal.rate_hz = 400;
-  imu_cal.gyroscope_noise_density_rad_s_sqrt_hz = 1.7e-4;
-  imu_cal.gyroscope_random_walk_rad_s2_sqrt_hz = 2e-5;
-  imu_cal.accelerometer_noise_density_m_s2_sqrt_hz = 6e-4;
-  imu_cal.accelerometer_random_walk_m_s3_sqrt_hz = 1e-4;
+  imu_cal.gyro_noise_density_rad_s_sqrt_hz = 1.7e-4;
+  imu_cal.gyro_random_walk_rad_s2_sqrt_hz = 2e-5;
+  imu_cal.accel_noise_density_m_s2_sqrt_hz = 6e-4;
+  imu_cal.accel_random_walk_m_s3_sqrt_hz = 1e-4;
   writer.WriteImuCalibration(imu_cal);
   writer.WriteCameraCalibration(0, Camera(0.045));
   writer.WriteCameraCalibration(1, Camera(-0.045));
@@ -104,11 +105,11 @@ TEST(EurocWriterTest, OurReaderReadsBackExactly) {
   ASSERT_EQ(d.stereo_frames().size(), 3u);
   const cv::Mat back = cv::imread(d.stereo_frames()[1].cam0_path, cv::IMREAD_GRAYSCALE);
   EXPECT_EQ(cv::countNonZero(back != w.cam0[1]), 0);
-  const drivers::CameraCalibration expected = Camera(0.045);
+  const calib::CameraModel expected = Camera(0.045);
   EXPECT_EQ(d.cam0().intrinsics, expected.intrinsics);
   EXPECT_EQ(d.cam0().distortion, expected.distortion);
   EXPECT_TRUE(d.cam0().T_body_cam.isApprox(expected.T_body_cam, 1e-12));
-  EXPECT_DOUBLE_EQ(d.imu_calibration().gyroscope_noise_density_rad_s_sqrt_hz, 1.7e-4);
+  EXPECT_DOUBLE_EQ(d.imu_calibration().gyro_noise_density_rad_s_sqrt_hz, 1.7e-4);
   ASSERT_EQ(d.ground_truth().size(), 3u);
   EXPECT_EQ(d.ground_truth()[2].p_world_body, w.gt[2].p_world_body);
   EXPECT_NEAR(d.ground_truth()[2].q_world_body.angularDistance(w.gt[2].q_world_body), 0, 1e-12);
@@ -122,6 +123,24 @@ TEST(EurocWriterTest, OurReaderReadsBackExactly) {
   EXPECT_EQ(depth.at<uint16_t>(10, 10), 5000);
   EXPECT_EQ(ReadAll(dir.path() / "mav0/can0/data.csv"),
             "#timestamp [ns],id,dlc,data_hex\n5,0x181,8,0102030405060708\n");
+}
+
+TEST(EurocWriterTest, WritesTheCameraDistortionModel) {
+  const testing::TempDir dir("euroc_writer");
+  calib::CameraModel fisheye = Camera(0.045);
+  fisheye.distortion_model = calib::DistortionModel::kEquidistant;
+  fisheye.distortion = {0.0034, 0.0007, -0.0021, 0.0002};
+  {
+    EurocWriter writer(dir.path().string());
+    writer.WriteCameraCalibration(0, fisheye);
+    writer.WriteCameraCalibration(1, Camera(-0.045));
+  }
+  const calib::CameraModel cam0 =
+      calib::LoadEurocCamera(dir.File("mav0/cam0/sensor.yaml").string());
+  EXPECT_EQ(cam0.distortion_model, calib::DistortionModel::kEquidistant);
+  EXPECT_EQ(cam0.distortion, fisheye.distortion);
+  EXPECT_EQ(calib::LoadEurocCamera(dir.File("mav0/cam1/sensor.yaml").string()).distortion_model,
+            calib::DistortionModel::kRadialTangential);
 }
 
 TEST(EurocWriterTest, SameInputGivesByteIdenticalFiles) {

@@ -1,8 +1,9 @@
-#ifndef ROVER_ESTIMATOR_VO_STEREO_RECTIFIER_H_
-#define ROVER_ESTIMATOR_VO_STEREO_RECTIFIER_H_
+#ifndef ROVER_CORE_CALIB_STEREO_RECTIFIER_H_
+#define ROVER_CORE_CALIB_STEREO_RECTIFIER_H_
 
-// Stereo rectification for the VO front end. The undistort/rectify maps are
-// computed once from the calibration; every frame is then remapped with them.
+// Stereo rectification for the VO front end and the mapper. The
+// undistort/rectify maps are computed once from the calibration; every frame
+// is then remapped with them.
 //
 // Frames: `cam0rect` is cam0 rotated so that both rectified cameras share the
 // same orientation and image rows (OpenCV axes: x right, y down, z forward).
@@ -16,19 +17,15 @@
 #include <array>
 #include <optional>
 
-namespace rover::estimator::vo {
+#include "core/calib/camera_model.h"
 
-/// Pinhole + radial-tangential camera as the calibration gives it.
-struct CameraModel {
-  int width_px = 0;
-  int height_px = 0;
-  std::array<double, 4> intrinsics{};  ///< fu, fv, cu, cv [px]
-  std::array<double, 4> distortion{};  ///< k1, k2, p1, p2
-  Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
-};
+namespace rover::calib {
 
+/// How the rectified images are framed.
 struct StereoRectifierOptions {
-  /// OpenCV's free scaling: 0 keeps only valid pixels, 1 keeps all source pixels.
+  /// OpenCV's free scaling: 0 keeps only valid pixels, 1 keeps all source
+  /// pixels. For equidistant (fisheye) cameras it is OpenCV's `balance`,
+  /// which moves the focal length between the same two extremes.
   double alpha = 0.0;
 };
 
@@ -40,11 +37,16 @@ struct RectifiedIntrinsics {
   double cy = 0.0;
 };
 
+/// Rectification of one stereo head: remap tables for both cameras and the
+/// rectified geometry.
 class StereoRectifier {
  public:
   /// Computes the rectification and the remap tables. Returns nullopt when the
   /// calibration is unusable (sizes differ or are zero, focal lengths not
-  /// positive, cameras coincide or cam1 is not to the right of cam0).
+  /// positive, the two cameras use different distortion models, cameras
+  /// coincide or cam1 is not to the right of cam0). Radial-tangential heads
+  /// go through cv::stereoRectify and cv::initUndistortRectifyMap,
+  /// equidistant ones through their cv::fisheye counterparts.
   static std::optional<StereoRectifier> Create(const CameraModel& cam0, const CameraModel& cam1,
                                                const StereoRectifierOptions& options = {});
 
@@ -54,12 +56,15 @@ class StereoRectifier {
   /// Remaps one raw image of camera `index` (0 or 1); false on bad input.
   bool RectifyOne(int index, const cv::Mat& raw, cv::Mat* rect) const;
 
+  /// The pinhole matrix of both rectified images.
   const RectifiedIntrinsics& intrinsics() const { return intrinsics_; }
   /// Distance between the rectified optical centres [m] (> 0).
   double baseline_m() const { return baseline_m_; }
+  /// Size of the raw and of the rectified images.
   cv::Size image_size() const { return size_; }
   /// Pose of the body in the rectified cam0 frame.
   const Eigen::Isometry3d& T_cam0rect_body() const { return T_cam0rect_body_; }
+  /// Pose of the rectified cam0 frame in the body frame.
   Eigen::Isometry3d T_body_cam0rect() const { return T_cam0rect_body_.inverse(); }
 
  private:
@@ -73,6 +78,6 @@ class StereoRectifier {
   Eigen::Isometry3d T_cam0rect_body_ = Eigen::Isometry3d::Identity();
 };
 
-}  // namespace rover::estimator::vo
+}  // namespace rover::calib
 
-#endif  // ROVER_ESTIMATOR_VO_STEREO_RECTIFIER_H_
+#endif  // ROVER_CORE_CALIB_STEREO_RECTIFIER_H_

@@ -1,4 +1,4 @@
-#include "estimator/vo/stereo_rectifier.h"
+#include "core/calib/stereo_rectifier.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 
 #include "core/geometry/so3.h"
 
-namespace rover::estimator::vo {
+namespace rover::calib {
 namespace {
 
 // EuRoC V1 calibration (cam0, cam1 sensor.yaml), as plain numbers.
@@ -35,7 +35,17 @@ CameraModel EurocCam(int index) {
   return c;
 }
 
-// Projects a body-frame point into a raw (distorted) camera image.
+// The EuRoC geometry with an equidistant (fisheye) lens of mild distortion.
+CameraModel FisheyeCam(int index) {
+  CameraModel c = EurocCam(index);
+  c.distortion_model = DistortionModel::kEquidistant;
+  c.distortion = index == 0 ? std::array<double, 4>{0.012, -0.004, 0.0015, -0.0003}
+                            : std::array<double, 4>{0.010, -0.003, 0.0011, -0.0002};
+  return c;
+}
+
+// Projects a body-frame point into a raw (distorted) camera image, through
+// OpenCV rather than the model under test.
 Eigen::Vector2d ProjectRaw(const CameraModel& c, const Eigen::Vector3d& p_body) {
   const Eigen::Vector3d p = c.T_body_cam.inverse() * p_body;
   std::vector<cv::Point3d> in = {{p.x(), p.y(), p.z()}};
@@ -43,12 +53,18 @@ Eigen::Vector2d ProjectRaw(const CameraModel& c, const Eigen::Vector3d& p_body) 
   const cv::Matx33d k(c.intrinsics[0], 0, c.intrinsics[2], 0, c.intrinsics[1], c.intrinsics[3], 0,
                       0, 1);
   const cv::Vec4d d(c.distortion[0], c.distortion[1], c.distortion[2], c.distortion[3]);
-  cv::projectPoints(in, cv::Vec3d::zeros(), cv::Vec3d::zeros(), k, d, out);
+  if (c.distortion_model == DistortionModel::kEquidistant) {
+    cv::fisheye::projectPoints(in, out, cv::Vec3d::zeros(), cv::Vec3d::zeros(), k, d);
+  } else {
+    cv::projectPoints(in, cv::Vec3d::zeros(), cv::Vec3d::zeros(), k, d, out);
+  }
   return {out[0].x, out[0].y};
 }
 
-TEST(StereoRectifierTest, EurocGeometry) {
-  const CameraModel c0 = EurocCam(0), c1 = EurocCam(1);
+// Checks the rectified geometry of a EuRoC-like head and that a body point
+// projected through the raw cameras and rectified lands where the rectified
+// model predicts, on the same row in both images.
+void ExpectRectifiedGeometry(const CameraModel& c0, const CameraModel& c1) {
   const auto rect = StereoRectifier::Create(c0, c1);
   ASSERT_TRUE(rect.has_value());
   EXPECT_NEAR(rect->baseline_m(), 0.110, 0.002);
@@ -59,8 +75,6 @@ TEST(StereoRectifierTest, EurocGeometry) {
   EXPECT_LT(LogSO3(R).norm(), 0.05);
   EXPECT_LT((rect->T_body_cam0rect().translation() - c0.T_body_cam.translation()).norm(), 1e-9);
 
-  // A body point projected through the raw cameras and rectified lands where
-  // the rectified model predicts, on the same row in both images.
   cv::Mat raw0 = cv::Mat::zeros(480, 752, CV_8UC1), raw1 = raw0.clone();
   const Eigen::Vector3d p_body = c0.T_body_cam * Eigen::Vector3d(0.3, -0.2, 3.0);
   const Eigen::Vector2d u0 = ProjectRaw(c0, p_body), u1 = ProjectRaw(c1, p_body);
@@ -87,6 +101,18 @@ TEST(StereoRectifierTest, EurocGeometry) {
   EXPECT_LT((centroid(r1) - expected1).norm(), 0.3);
 }
 
+TEST(StereoRectifierTest, EurocGeometry) { ExpectRectifiedGeometry(EurocCam(0), EurocCam(1)); }
+
+TEST(StereoRectifierTest, EquidistantGeometry) {
+  ExpectRectifiedGeometry(FisheyeCam(0), FisheyeCam(1));
+}
+
+TEST(StereoRectifierTest, RejectsMixedDistortionModels) {
+  // OpenCV rectifies a pair of one model only.
+  EXPECT_FALSE(StereoRectifier::Create(EurocCam(0), FisheyeCam(1)).has_value());
+  EXPECT_FALSE(StereoRectifier::Create(FisheyeCam(0), EurocCam(1)).has_value());
+}
+
 TEST(StereoRectifierTest, RejectsBadCalibrationAndImages) {
   CameraModel c0 = EurocCam(0), c1 = EurocCam(1);
   CameraModel same = c0;
@@ -110,4 +136,4 @@ TEST(StereoRectifierTest, RejectsBadCalibrationAndImages) {
 }
 
 }  // namespace
-}  // namespace rover::estimator::vo
+}  // namespace rover::calib

@@ -1,11 +1,11 @@
-#include "estimator/vo/stereo_rectifier.h"
+#include "core/calib/stereo_rectifier.h"
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
 
-namespace rover::estimator::vo {
+namespace rover::calib {
 namespace {
 
 cv::Mat CameraMatrix(const CameraModel& c) {
@@ -33,9 +33,13 @@ std::optional<StereoRectifier> StereoRectifier::Create(const CameraModel& cam0,
                                                        const CameraModel& cam1,
                                                        const StereoRectifierOptions& options) {
   if (!Valid(cam0) || !Valid(cam1) || cam0.width_px != cam1.width_px ||
-      cam0.height_px != cam1.height_px) {
+      cam0.height_px != cam1.height_px || cam0.distortion_model != cam1.distortion_model) {
     return std::nullopt;
   }
+  // OpenCV rectifies a pair of one model only; the radial-tangential path is
+  // the one the accuracy figures were measured with and stays call for call
+  // as it was.
+  const bool fisheye = cam0.distortion_model == DistortionModel::kEquidistant;
   // x_cam1 = R * x_cam0 + T.
   const Eigen::Isometry3d T_cam1_cam0 = cam1.T_body_cam.inverse() * cam0.T_body_cam;
   if (T_cam1_cam0.translation().norm() < 1e-6) return std::nullopt;
@@ -50,8 +54,13 @@ std::optional<StereoRectifier> StereoRectifier::Create(const CameraModel& cam0,
   cv::Mat r0, r1, p0, p1, q;
   const cv::Mat k0 = CameraMatrix(cam0), k1 = CameraMatrix(cam1);
   const cv::Mat d0 = Distortion(cam0), d1 = Distortion(cam1);
-  cv::stereoRectify(k0, d0, k1, d1, out.size_, r, t, r0, r1, p0, p1, q, cv::CALIB_ZERO_DISPARITY,
-                    options.alpha, out.size_);
+  if (fisheye) {
+    cv::fisheye::stereoRectify(k0, d0, k1, d1, out.size_, r, t, r0, r1, p0, p1, q,
+                               cv::fisheye::CALIB_ZERO_DISPARITY, out.size_, options.alpha);
+  } else {
+    cv::stereoRectify(k0, d0, k1, d1, out.size_, r, t, r0, r1, p0, p1, q, cv::CALIB_ZERO_DISPARITY,
+                      options.alpha, out.size_);
+  }
   const double fx = p0.at<double>(0, 0);
   const double baseline = -p1.at<double>(0, 3) / fx;
   if (!(fx > 0.0) || !(baseline > 0.0) || !std::isfinite(baseline)) return std::nullopt;
@@ -64,8 +73,15 @@ std::optional<StereoRectifier> StereoRectifier::Create(const CameraModel& cam0,
   Eigen::Isometry3d T_rect_cam0 = Eigen::Isometry3d::Identity();
   T_rect_cam0.linear() = R_rect_cam0;
   out.T_cam0rect_body_ = T_rect_cam0 * cam0.T_body_cam.inverse();
-  cv::initUndistortRectifyMap(k0, d0, r0, p0, out.size_, CV_16SC2, out.map_a_[0], out.map_b_[0]);
-  cv::initUndistortRectifyMap(k1, d1, r1, p1, out.size_, CV_16SC2, out.map_a_[1], out.map_b_[1]);
+  if (fisheye) {
+    cv::fisheye::initUndistortRectifyMap(k0, d0, r0, p0, out.size_, CV_16SC2, out.map_a_[0],
+                                         out.map_b_[0]);
+    cv::fisheye::initUndistortRectifyMap(k1, d1, r1, p1, out.size_, CV_16SC2, out.map_a_[1],
+                                         out.map_b_[1]);
+  } else {
+    cv::initUndistortRectifyMap(k0, d0, r0, p0, out.size_, CV_16SC2, out.map_a_[0], out.map_b_[0]);
+    cv::initUndistortRectifyMap(k1, d1, r1, p1, out.size_, CV_16SC2, out.map_a_[1], out.map_b_[1]);
+  }
   return out;
 }
 
@@ -87,4 +103,4 @@ bool StereoRectifier::Rectify(const cv::Mat& raw0, const cv::Mat& raw1, cv::Mat*
   return RectifyOne(0, raw0, rect0) && RectifyOne(1, raw1, rect1);
 }
 
-}  // namespace rover::estimator::vo
+}  // namespace rover::calib
