@@ -68,15 +68,6 @@ CameraModel LoadCamera(const ConfigNode& n) {
   return c;
 }
 
-WheelCalibration LoadWheels(const ConfigNode& n) {
-  WheelCalibration c;
-  c.wheel_radius_m = n.Get<double>("wheel_radius_m");
-  c.track_m = n.Get<double>("track_m");
-  c.lever_arm_body_m = n.Get<Eigen::Vector3d>("lever_arm_body_m");
-  FailOn(n, c.Problem());
-  return c;
-}
-
 // Writes "key: value" lines at one indentation.
 class YamlBlock {
  public:
@@ -89,9 +80,6 @@ class YamlBlock {
   void Put(std::string_view key, const std::array<double, 4>& v, std::string_view comment) {
     Line(key, " [" + NumberText(v[0]) + ", " + NumberText(v[1]) + ", " + NumberText(v[2]) + ", " +
                   NumberText(v[3]) + "]  # " + std::string(comment));
-  }
-  void Put(std::string_view key, const Eigen::Vector3d& v) {
-    Line(key, " [" + NumberText(v.x()) + ", " + NumberText(v.y()) + ", " + NumberText(v.z()) + "]");
   }
   // A 4x4 transform as a flat row-major list, one matrix row per line.
   void Put(std::string_view key, const Eigen::Isometry3d& T) {
@@ -161,7 +149,7 @@ BoardCalibration BoardCalibration::Load(const ConfigNode& node) {
     c.stereo =
         StereoCalibration{LoadCamera(cameras.Child("cam0")), LoadCamera(cameras.Child("cam1"))};
   }
-  if (node.Has("wheels")) c.wheels = LoadWheels(node.Child("wheels"));
+  if (node.Has("wheels")) c.wheels = WheelCalibration::Load(node.Child("wheels"));
   return c;
 }
 
@@ -186,10 +174,7 @@ std::string BoardCalibration::ToYaml() const {
   }
   if (wheels) {
     top.Section("wheels");
-    YamlBlock w(&out, 2);
-    w.Put("wheel_radius_m", wheels->wheel_radius_m);
-    w.Put("track_m", wheels->track_m);
-    w.Put("lever_arm_body_m", wheels->lever_arm_body_m);
+    out += wheels->ToYaml(2);
   }
   return out;
 }

@@ -30,6 +30,10 @@
 //     wheel_radius_m: 0.1
 //     track_m: 0.5
 //     lever_arm_body_m: [0, 0, -0.25]
+//     nonholonomic_point_body_m: [0, 0, -0.35]  # the wheel-terrain keys are
+//     yaw_scrub_factor: 1.3                      # optional (wheel_calibration.h)
+//     slip_ratio_base: 0.02
+//     slip_ratio_per_tilt_rad: 0.1
 //
 // Every key shown is required within its section; unknown keys are errors.
 // `distortion` is k1 k2 p1 p2 for pinhole-radtan and k1 k2 k3 k4 for

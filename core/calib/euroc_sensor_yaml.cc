@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <vector>
 
+#include "core/config/config.h"
+
 namespace rover::calib {
 namespace {
 
@@ -107,13 +109,63 @@ ImuCalibration LoadEurocImu(const std::string& path) {
   return c;
 }
 
-BoardCalibration LoadEurocCalibration(const std::string& mav0_dir) {
-  const fs::path mav0(mav0_dir);
+WheelCalibration LoadEurocWheels(const std::string& sensor_yaml) {
+  try {
+    const ConfigNode root = ConfigNode::LoadFile(sensor_yaml);
+    const std::string type = root.Get<std::string>("sensor_type");
+    if (type != kWheelSensorType) {
+      root.Fail("sensor_type",
+                "expected " + std::string(kWheelSensorType) + ", found '" + type + "'");
+    }
+    (void)root.Get<std::string>("comment", "");
+    const WheelCalibration c = WheelCalibration::Load(root);
+    root.CheckNoUnknownKeysRecursive();
+    return c;
+  } catch (const ConfigError& e) {
+    throw CalibrationError(e.what());
+  }
+}
+
+std::string EurocWheelsYaml(const WheelCalibration& wheels, const std::string& comment) {
+  return "sensor_type: " + std::string(kWheelSensorType) + "
+comment: " + comment + "
+" +
+         wheels.ToYaml();
+}
+
+namespace {
+
+// The sensors of an EuRoC-layout folder; without `cameras_required`, a
+// folder without cam0/ and cam1/ is a board without a stereo head.
+BoardCalibration LoadEurocFolder(const fs::path& dir, bool cameras_required) {
   BoardCalibration c;
-  c.imu = LoadEurocImu((mav0 / "imu0/sensor.yaml").string());
-  c.stereo = StereoCalibration{LoadEurocCamera((mav0 / "cam0/sensor.yaml").string()),
-                               LoadEurocCamera((mav0 / "cam1/sensor.yaml").string())};
+  c.imu = LoadEurocImu((dir / "imu0/sensor.yaml").string());
+  const fs::path cam0 = dir / "cam0/sensor.yaml", cam1 = dir / "cam1/sensor.yaml";
+  if (cameras_required || fs::exists(cam0) || fs::exists(cam1)) {
+    c.stereo = StereoCalibration{LoadEurocCamera(cam0.string()), LoadEurocCamera(cam1.string())};
+  }
+  const fs::path wheels = dir / "can0/sensor.yaml";
+  if (fs::exists(wheels)) c.wheels = LoadEurocWheels(wheels.string());
   return c;
+}
+
+}  // namespace
+
+BoardCalibration LoadEurocCalibration(const std::string& mav0_dir) {
+  return LoadEurocFolder(mav0_dir, true);
+}
+
+BoardCalibration LoadBoardCalibration(const std::string& path) {
+  if (fs::is_directory(path)) return LoadEurocFolder(path, false);
+  if (!fs::is_regular_file(path)) {
+    throw CalibrationError(path + ": expected a board calibration file or an EuRoC calibration "
+                                  "folder (imu0/ cam0/ cam1/), found nothing there");
+  }
+  try {
+    return BoardCalibration::LoadFile(path);
+  } catch (const ConfigError& e) {
+    throw CalibrationError(e.what());
+  }
 }
 
 }  // namespace rover::calib

@@ -1,7 +1,6 @@
 #include "firmware/roverd/hardware_board.h"
 
 #include <cstdio>
-#include <filesystem>
 #include <stdexcept>
 
 #include "core/calib/board_calibration.h"
@@ -15,12 +14,11 @@
 #include "drivers/imu/adis16448_driver.h"
 #include "drivers/imu/spidev_device.h"
 #include "drivers/imu/xsens_mti_driver.h"
-#include "firmware/roverd/sensor_calibration.h"
+#include "estimator/feed/filter_options.h"
 
 namespace rover::roverd {
 namespace {
 
-namespace fs = std::filesystem;
 
 // "400 Hz", "409.6 Hz": rates as a user wrote them.
 std::string Hz(double rate_hz) {
@@ -29,27 +27,31 @@ std::string Hz(double rate_hz) {
   return text;
 }
 
-std::string SensorYaml(const std::string& folder, const std::string& sensor) {
-  const fs::path path = fs::path(folder) / sensor / "sensor.yaml";
-  if (!fs::is_regular_file(path)) {
-    throw std::invalid_argument("hardware.calibration: expected " + path.string() +
-                                " (EuRoC sensor.yaml of " + sensor + "), found no such file");
+/// The board's calibration (hardware.calibration: a board calibration file
+/// or an EuRoC calibration folder); with a stereo head it must calibrate both
+/// cameras at the image size they are set to: the intrinsics of another size
+/// would be silently wrong.
+calib::BoardCalibration LoadCalibration(const runtime::BoardHardwareOptions& options) {
+  calib::BoardCalibration c;
+  try {
+    c = calib::LoadBoardCalibration(options.calibration);
+  } catch (const calib::CalibrationError& e) {
+    throw std::invalid_argument(std::string("hardware.calibration: ") + e.what());
   }
-  return path.string();
-}
-
-/// A camera's calibration, which must be for the image size the camera is
-/// set to: the intrinsics of another size would be silently wrong.
-calib::CameraModel CameraCalibrationFor(const std::string& folder, const std::string& sensor,
-                                        const runtime::BoardCameraOptions& camera) {
-  const std::string path = SensorYaml(folder, sensor);
-  calib::CameraModel c = calib::LoadEurocCamera(path);
-  if (c.width_px != camera.width_px || c.height_px != camera.height_px) {
-    throw std::invalid_argument(
-        "hardware.camera.width_px: " + path + " calibrates " + sensor + " at " +
-        std::to_string(c.width_px) + "x" + std::to_string(c.height_px) +
-        " (resolution), expected the camera's " + std::to_string(camera.width_px) + "x" +
-        std::to_string(camera.height_px));
+  if (!options.camera) return c;
+  if (!c.stereo) {
+    throw std::invalid_argument("hardware.calibration: expected cam0 and cam1 in " +
+                                options.calibration + " (hardware.camera is set), found none");
+  }
+  const runtime::BoardCameraOptions& camera = *options.camera;
+  for (const calib::CameraModel* m : {&c.stereo->cam0, &c.stereo->cam1}) {
+    if (m->width_px != camera.width_px || m->height_px != camera.height_px) {
+      throw std::invalid_argument(
+          "hardware.camera.width_px: " + options.calibration + " calibrates " +
+          (m == &c.stereo->cam0 ? "cam0" : "cam1") + " at " + std::to_string(m->width_px) + "x" +
+          std::to_string(m->height_px) + " (resolution), expected the camera's " +
+          std::to_string(camera.width_px) + "x" + std::to_string(camera.height_px));
+    }
   }
   return c;
 }
@@ -94,20 +96,19 @@ HardwareBoard::HardwareBoard(const runtime::BoardHardwareOptions& options) {
   if (auto problem = options.Problem()) {
     throw std::invalid_argument(problem->first + ": " + problem->second);
   }
-  const calib::ImuCalibration imu = calib::LoadEurocImu(SensorYaml(options.calibration, "imu0"));
-  options_.estimator = FilterOptionsFromCalibration(imu, options.estimator_config);
+  calib::BoardCalibration calibration = LoadCalibration(options);
+  // Wheel odometry needs the drives on the bus as well as their calibration.
+  if (!options.can) calibration.wheels.reset();
+  options_.estimator =
+      estimator::FilterOptionsFromCalibration(calibration, options.estimator_config);
+  // The IMU runs at the rate the board configures it to.
   options_.estimator.imu.rate_hz = options.imu.rate_hz;
   if (options.camera) {
     CameraSetup head;
     // The filter's body is the IMU frame.
-    head.cam0 = calib::CameraInImuFrame(
-        CameraCalibrationFor(options.calibration, "cam0", *options.camera), imu);
-    head.cam1 = calib::CameraInImuFrame(
-        CameraCalibrationFor(options.calibration, "cam1", *options.camera), imu);
-    if (!options.vo_config.empty()) {
-      head.vo = estimator::vo::StereoOdometryOptions::LoadFile(options.vo_config);
-    }
-    head.vo.checks.nominal_rate_hz = options.camera->rate_hz;
+    head.cam0 = calib::CameraInImuFrame(calibration.stereo->cam0, calibration.imu);
+    head.cam1 = calib::CameraInImuFrame(calibration.stereo->cam1, calibration.imu);
+    head.vo = estimator::VoOptionsFromCalibration(options.camera->rate_hz, options.vo_config);
     options_.camera = head;
   }
   // Cameras stream from the moment they are opened into their few capture

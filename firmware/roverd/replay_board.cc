@@ -3,7 +3,7 @@
 #include <stdexcept>
 
 #include "core/calib/board_calibration.h"
-#include "firmware/roverd/sensor_calibration.h"
+#include "estimator/feed/filter_options.h"
 
 namespace rover::roverd {
 
@@ -20,17 +20,17 @@ ReplayBoard::ReplayBoard(const runtime::BoardReplayOptions& options)
                                 std::to_string(dataset_.stereo_frames().size()));
   }
   options_.lockstep = options.lockstep;
+  // The replay board plays no wheel drives back: without their speeds the
+  // filter runs without wheel odometry, whatever the dataset calibrates.
+  calib::BoardCalibration calibration = dataset_.calibration();
+  calibration.wheels.reset();
   options_.estimator =
-      FilterOptionsFromCalibration(dataset_.imu_calibration(), options.estimator_config);
+      estimator::FilterOptionsFromCalibration(calibration, options.estimator_config);
   CameraSetup head;
   // The filter's body is the IMU frame.
-  head.cam0 = calib::CameraInImuFrame(dataset_.cam0(), dataset_.imu_calibration());
-  head.cam1 = calib::CameraInImuFrame(dataset_.cam1(), dataset_.imu_calibration());
-  if (!options.vo_config.empty()) {
-    head.vo = estimator::vo::StereoOdometryOptions::LoadFile(options.vo_config);
-  } else if (dataset_.cam0().rate_hz > 0.0) {
-    head.vo.checks.nominal_rate_hz = dataset_.cam0().rate_hz;
-  }
+  head.cam0 = calib::CameraInImuFrame(dataset_.cam0(), calibration.imu);
+  head.cam1 = calib::CameraInImuFrame(dataset_.cam1(), calibration.imu);
+  head.vo = estimator::VoOptionsFromCalibration(dataset_.cam0().rate_hz, options.vo_config);
   options_.camera = head;
 }
 

@@ -6,7 +6,7 @@
 // HardwareBoard turns them into the drivers' own options.
 //
 //   hardware:
-//     calibration: /etc/rover/calibration  # imu0/ cam0/ cam1/ sensor.yaml (EuRoC format)
+//     calibration: /etc/rover/calibration.yaml  # board calibration file, or an EuRoC folder
 //     estimator_config: ""                 # EskfOptions YAML; "" = defaults + imu0's noise
 //     vo_config: ""                        # StereoOdometryOptions YAML; "" = defaults
 //     imu: {driver: xsens, device: /dev/ttyUSB0, rate_hz: 400, baud_rate: 921600}
@@ -77,9 +77,10 @@ struct BoardCanOptions {
 };
 
 struct BoardHardwareOptions {
-  /// Folder with imu0/sensor.yaml and, with a camera, cam0/ and cam1/
-  /// sensor.yaml (the EuRoC calibration format), written by the
-  /// calibration tools.
+  /// The board's calibration: a board calibration file (core/calib format)
+  /// or a folder with imu0/ and, with a camera, cam0/ and cam1/ (and, for
+  /// wheel odometry, can0/) sensor.yaml in the EuRoC layout
+  /// (calib::LoadBoardCalibration).
   std::string calibration;
   std::string estimator_config{};
   std::string vo_config{};

@@ -16,28 +16,6 @@
 namespace rover::sim {
 namespace {
 
-calib::ImuCalibration ImuCalibrationOf(const ImuModelOptions& imu) {
-  calib::ImuCalibration c;
-  c.rate_hz = imu.rate_hz;
-  c.gyro_noise_density_rad_s_sqrt_hz = imu.gyro.noise_density;
-  c.gyro_random_walk_rad_s2_sqrt_hz = imu.gyro.bias_random_walk;
-  c.accel_noise_density_m_s2_sqrt_hz = imu.accel.noise_density;
-  c.accel_random_walk_m_s3_sqrt_hz = imu.accel.bias_random_walk;
-  return c;  // the body frame is the IMU frame: T_BS = identity
-}
-
-calib::CameraModel CameraCalibrationOf(const StereoCameraOptions& cam,
-                                       const Eigen::Isometry3d& T_body_cam) {
-  calib::CameraModel c;
-  c.width_px = cam.width_px;
-  c.height_px = cam.height_px;
-  c.rate_hz = cam.rate_hz;
-  c.intrinsics = {cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px};
-  c.distortion = cam.DistortionCoeffs();
-  c.T_body_cam = T_body_cam;
-  return c;
-}
-
 double SecondsSince(Time start) { return (Time::Now() - start).ToSeconds(); }
 
 // Everything one rover records, into its own EuRoC-layout folder.
@@ -63,8 +41,8 @@ void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
                      (c.self * 0xC2B2AE3D27D4EB4FULL);
   writer.WriteImuCalibration(ImuCalibrationOf(imu_options));
   const StereoCameraOptions& camera = c.scenario.camera;
-  writer.WriteCameraCalibration(0, CameraCalibrationOf(camera, camera.T_body_cam0));
-  writer.WriteCameraCalibration(1, CameraCalibrationOf(camera, camera.T_body_cam1()));
+  writer.WriteCameraCalibration(0, CameraModelOf(camera, camera.T_body_cam0));
+  writer.WriteCameraCalibration(1, CameraModelOf(camera, camera.T_body_cam1()));
 
   // IMU, its data-ready edges and the ground truth (with the IMU's true
   // biases) come from one pass over the IMU samples.
@@ -99,6 +77,7 @@ void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
   if (!c.scenario.wheels_config.empty()) {
     wheel_options = WheelOdometryModelOptions::LoadFile(c.scenario.wheels_config);
   }
+  writer.WriteWheelCalibration(WheelCalibrationOf(trajectory, wheel_options));
   WheelOdometryModel wheels(wheel_options, trajectory, c.world.terrain, t0);
   std::vector<drivers::CanFrame> frames;
   std::vector<WheelSyncState> states;

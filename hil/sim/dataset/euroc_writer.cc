@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/calib/euroc_sensor_yaml.h"
+
 namespace rover::sim {
 namespace {
 
@@ -129,6 +131,10 @@ void EurocWriter::WriteCameraCalibration(int index, const calib::CameraModel& c)
                   "# depth0: z-depth of cam0 in the distorted cam0 image, uint16 PNG in "
                   "millimetres, 0 = no surface\ndepth_scale_m: 0.001\n");
   }
+}
+
+void EurocWriter::WriteWheelCalibration(const calib::WheelCalibration& c) {
+  WriteText(files_->mav0 / "can0/sensor.yaml", calib::EurocWheelsYaml(c, "rover-sim wheel drives"));
 }
 
 void EurocWriter::AddImu(const drivers::ImuSample& s) {

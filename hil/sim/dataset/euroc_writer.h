@@ -25,6 +25,7 @@
 
 #include "core/calib/camera_model.h"
 #include "core/calib/imu_calibration.h"
+#include "core/calib/wheel_calibration.h"
 #include "drivers/can/can_frame.h"
 #include "drivers/gpio/gpio_edge.h"
 #include "drivers/imu/imu_sample.h"
@@ -50,6 +51,9 @@ class EurocWriter {
   void WriteImuCalibration(const calib::ImuCalibration& calibration);
   /// `index` 0 or 1.
   void WriteCameraCalibration(int index, const calib::CameraModel& calibration);
+  /// mav0/can0/sensor.yaml: the wheel drives' calibration
+  /// (calib::LoadEurocWheels reads it).
+  void WriteWheelCalibration(const calib::WheelCalibration& calibration);
 
   void AddImu(const drivers::ImuSample& sample);
   /// 8-bit mono images of one trigger.

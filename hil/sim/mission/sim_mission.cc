@@ -12,6 +12,7 @@
 #include "drivers/replay/euroc_replay.h"
 #include "firmware/roverd/roverd_process.h"
 #include "firmware/roverd/roverd_summary.h"
+#include "estimator/feed/filter_options.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/estimator_feed/filter_run.h"
 #include "hil/sim/live/sim_camera_trigger.h"
@@ -122,17 +123,6 @@ std::string Fixed(double v, int digits) {
 
 }  // namespace
 
-calib::CameraModel CameraModelOf(const StereoCameraOptions& cam,
-                                 const Eigen::Isometry3d& T_body_cam) {
-  calib::CameraModel m;
-  m.width_px = cam.width_px;
-  m.height_px = cam.height_px;
-  m.intrinsics = {cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px};
-  m.distortion = cam.DistortionCoeffs();
-  m.T_body_cam = T_body_cam;
-  return m;
-}
-
 MissionResult RunMission(const MissionOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   MissionResult result;
@@ -171,11 +161,10 @@ MissionResult RunMission(const MissionOptions& options) {
 
   roverd::RoverdOptions rover;
   rover.estimator = EskfOptionsForScenario(scenario, trajectory, wheel_options, true);
-  rover.estimator.clones.max_clones = estimator::kMaxClones;  // 5 keyframes + frames in flight
   roverd::CameraSetup head;
   head.cam0 = CameraModelOf(scenario.camera, scenario.camera.T_body_cam0);
   head.cam1 = CameraModelOf(scenario.camera, scenario.camera.T_body_cam1());
-  head.vo.checks.nominal_rate_hz = scenario.camera.rate_hz;
+  head.vo = estimator::VoOptionsFromCalibration(scenario.camera.rate_hz);
   rover.camera = head;
   rover.lockstep = options.lockstep;
   if (options.board) roverd::ApplyBoard(*options.board, &rover);

@@ -69,11 +69,6 @@ MissionResult RunMission(const MissionOptions& options);
 /// The summary, ending with the RESULT line of the command-line contract.
 void PrintMissionSummary(const MissionResult& result, std::ostream& out);
 
-/// The calibration roverd (and mapd, through roverd) uses for one of the
-/// simulator's cameras at `T_body_cam`.
-calib::CameraModel CameraModelOf(const StereoCameraOptions& camera,
-                                 const Eigen::Isometry3d& T_body_cam);
-
 }  // namespace rover::sim
 
 #endif  // ROVER_HIL_SIM_MISSION_SIM_MISSION_H_

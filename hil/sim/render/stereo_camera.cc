@@ -158,4 +158,16 @@ bool PixelToRay(const StereoCameraOptions& camera, const Eigen::Vector2d& uv_px,
   return true;
 }
 
+calib::CameraModel CameraModelOf(const StereoCameraOptions& camera,
+                                 const Eigen::Isometry3d& T_body_cam) {
+  calib::CameraModel c;
+  c.width_px = camera.width_px;
+  c.height_px = camera.height_px;
+  c.rate_hz = camera.rate_hz;
+  c.intrinsics = {camera.fx_px, camera.fy_px, camera.cx_px, camera.cy_px};
+  c.distortion = camera.DistortionCoeffs();
+  c.T_body_cam = T_body_cam;
+  return c;
+}
+
 }  // namespace rover::sim

@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 #include <array>
 
+#include "core/calib/camera_model.h"
 #include "core/config/config.h"
 
 namespace rover::sim {
@@ -88,6 +89,12 @@ bool ProjectToPixel(const StereoCameraOptions& camera, const Eigen::Vector3d& p_
 /// The unit ray (camera coordinates) through a distorted pixel.
 bool PixelToRay(const StereoCameraOptions& camera, const Eigen::Vector2d& uv_px,
                 Eigen::Vector3d* ray_cam);
+
+/// What a calibration of the simulated camera at `T_body_cam` states (its
+/// size, rate, intrinsics and lens): the model roverd, mapd and a generated
+/// dataset's sensor.yaml all use.
+calib::CameraModel CameraModelOf(const StereoCameraOptions& camera,
+                                 const Eigen::Isometry3d& T_body_cam);
 
 }  // namespace rover::sim
 
