@@ -32,7 +32,6 @@
 namespace rover::estimator::vo {
 namespace {
 
-using testing::ToModel;
 
 struct Options {
   std::string dataset = ROVER_VO_BENCH_DATA;

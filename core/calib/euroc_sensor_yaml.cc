@@ -127,9 +127,7 @@ WheelCalibration LoadEurocWheels(const std::string& sensor_yaml) {
 }
 
 std::string EurocWheelsYaml(const WheelCalibration& wheels, const std::string& comment) {
-  return "sensor_type: " + std::string(kWheelSensorType) + "
-comment: " + comment + "
-" +
+  return "sensor_type: " + std::string(kWheelSensorType) + "\ncomment: " + comment + "\n" +
          wheels.ToYaml();
 }
 

@@ -58,20 +58,13 @@ std::string WheelCalibration::ToYaml(int indent) const {
   const auto vec = [](const Eigen::Vector3d& v) {
     return "[" + NumberText(v.x()) + ", " + NumberText(v.y()) + ", " + NumberText(v.z()) + "]";
   };
-  return pad + "wheel_radius_m: " + NumberText(wheel_radius_m) + "
-" + pad +
-         "track_m: " + NumberText(track_m) + "
-" + pad +
-         "lever_arm_body_m: " + vec(lever_arm_body_m) + "
-" + pad +
-         "nonholonomic_point_body_m: " + vec(nonholonomic_point_body_m) + "
-" + pad +
-         "yaw_scrub_factor: " + NumberText(yaw_scrub_factor) + "
-" + pad +
-         "slip_ratio_base: " + NumberText(slip_ratio_base) + "
-" + pad +
-         "slip_ratio_per_tilt_rad: " + NumberText(slip_ratio_per_tilt_rad) + "
-";
+  return pad + "wheel_radius_m: " + NumberText(wheel_radius_m) + "\n" + pad +
+         "track_m: " + NumberText(track_m) + "\n" + pad +
+         "lever_arm_body_m: " + vec(lever_arm_body_m) + "\n" + pad +
+         "nonholonomic_point_body_m: " + vec(nonholonomic_point_body_m) + "\n" + pad +
+         "yaw_scrub_factor: " + NumberText(yaw_scrub_factor) + "\n" + pad +
+         "slip_ratio_base: " + NumberText(slip_ratio_base) + "\n" + pad +
+         "slip_ratio_per_tilt_rad: " + NumberText(slip_ratio_per_tilt_rad) + "\n";
 }
 
 }  // namespace rover::calib

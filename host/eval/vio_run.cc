@@ -27,6 +27,7 @@ namespace {
 namespace ev = rover::eval;
 namespace vo = rover::estimator::vo;
 namespace fs = std::filesystem;
+using cli::Fixed;
 using cli::General;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

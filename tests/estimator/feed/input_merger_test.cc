@@ -21,6 +21,15 @@ Time Ms(int64_t ms) { return Time::FromNanoseconds(ms * 1'000'000); }
 
 ImuMeasurement Imu(int64_t ms) { return ImuMeasurement{Ms(ms), {}, {}}; }
 
+// A relative pose delivered at `stamp` (its content does not matter here).
+RelativePoseMeasurement Pose(Time stamp) {
+  RelativePoseMeasurement m;
+  m.stamp = stamp;
+  m.from_stamp = stamp;
+  m.to_stamp = stamp;
+  return m;
+}
+
 // A short text per input kind, to compare sequences readably.
 char KindOf(const EskfInput& input) {
   static constexpr char kKinds[] = "IWTRSP";
@@ -35,7 +44,7 @@ std::string Kinds(const std::vector<EskfInput>& inputs) {
 
 TEST(InputOrderTest, EqualStampsGoImuWheelTriggerRelativePoseRequests) {
   std::vector<EskfInput> in = {PoseReportRequest{Ms(5), 1}, FrameSwitchRequest{Ms(5)},
-                               RelativePoseMeasurement{Ms(5), Ms(1), Ms(4)},
+                               Pose(Ms(5)),
                                CloneTrigger{Ms(5)},
                                WheelSpeedMeasurement{Ms(5), {}},
                                Imu(5),
@@ -77,7 +86,7 @@ TEST(InputMergerTest, LateInputsAreFedBeforeTheNextSampleAndCounted) {
   std::vector<EskfInput> fed;
   const auto feed = [&](const EskfInput& in) { fed.push_back(in); };
   merger.Step(Imu(10), feed);
-  ASSERT_TRUE(merger.Push(RelativePoseMeasurement{Ms(7), Ms(1), Ms(5)}));  // before 10 ms: late
+  ASSERT_TRUE(merger.Push(Pose(Ms(7))));  // before 10 ms: late
   ASSERT_TRUE(merger.Push(CloneTrigger{Ms(10)}));  // at the last sample's stamp: not late
   fed.clear();
   merger.Step(Imu(15), feed);
@@ -128,7 +137,7 @@ TEST(InputMergerTest, AgreesWithTheGlobalSortOnRandomStreams) {
       switch (rng() % 5) {
         case 0: aiding.emplace_back(WheelSpeedMeasurement{t, {}}); break;
         case 1: aiding.emplace_back(CloneTrigger{t}); break;
-        case 2: aiding.emplace_back(RelativePoseMeasurement{t, t, t}); break;
+        case 2: aiding.emplace_back(Pose(t)); break;
         case 3: aiding.emplace_back(FrameSwitchRequest{t}); break;
         default: aiding.emplace_back(PoseReportRequest{t, rng() % 100}); break;
       }

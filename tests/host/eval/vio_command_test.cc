@@ -27,6 +27,7 @@
 #include "host/eval/can_frames_csv.h"
 #include "host/eval/vio_command.h"
 #include "host/eval/vio_evaluation.h"
+#include "host/eval/vio_report.h"
 #include "tests/support/temp_dir.h"
 
 namespace rover::host::eval {
