@@ -32,7 +32,6 @@
 namespace rover::estimator::vo {
 namespace {
 
-
 struct Options {
   std::string dataset = ROVER_VO_BENCH_DATA;
   size_t frames = 0;  // 0: all

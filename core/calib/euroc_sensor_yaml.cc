@@ -156,8 +156,9 @@ BoardCalibration LoadEurocCalibration(const std::string& mav0_dir) {
 BoardCalibration LoadBoardCalibration(const std::string& path) {
   if (fs::is_directory(path)) return LoadEurocFolder(path, false);
   if (!fs::is_regular_file(path)) {
-    throw CalibrationError(path + ": expected a board calibration file or an EuRoC calibration "
-                                  "folder (imu0/ cam0/ cam1/), found nothing there");
+    throw CalibrationError(path +
+                           ": expected a board calibration file or an EuRoC calibration "
+                           "folder (imu0/ cam0/ cam1/), found nothing there");
   }
   try {
     return BoardCalibration::LoadFile(path);

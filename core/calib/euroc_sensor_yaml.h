@@ -61,8 +61,8 @@ BoardCalibration LoadEurocCalibration(const std::string& mav0_dir);
 
 /// A board's calibration from `path`: a board calibration file
 /// (board_calibration.h), or a folder in the EuRoC layout (imu0/, and
-/// cam0/ + cam1/ for a stereo head, can0/ for wheel drives: sensor.yaml each). Throws CalibrationError naming the
-/// file (and line and key) it cannot use.
+/// cam0/ + cam1/ for a stereo head, can0/ for wheel drives: sensor.yaml each). Throws
+/// CalibrationError naming the file (and line and key) it cannot use.
 BoardCalibration LoadBoardCalibration(const std::string& path);
 
 }  // namespace rover::calib

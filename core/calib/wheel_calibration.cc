@@ -28,9 +28,8 @@ std::optional<FieldProblem> WheelCalibration::Problem() const {
                         "expected a finite ratio, found " + NumberText(slip_ratio_base)};
   }
   if (!std::isfinite(slip_ratio_per_tilt_rad)) {
-    return FieldProblem{"slip_ratio_per_tilt_rad",
-                        "expected a finite ratio per radian, found " +
-                            NumberText(slip_ratio_per_tilt_rad)};
+    return FieldProblem{"slip_ratio_per_tilt_rad", "expected a finite ratio per radian, found " +
+                                                       NumberText(slip_ratio_per_tilt_rad)};
   }
   return std::nullopt;
 }
@@ -41,12 +40,13 @@ WheelCalibration WheelCalibration::Load(const ConfigNode& node) {
   c.track_m = node.Get<double>("track_m");
   c.lever_arm_body_m = node.Get<Eigen::Vector3d>("lever_arm_body_m");
   // Without a stated point, the contact centre under the wheel centres.
-  c.nonholonomic_point_body_m = node.Get<Eigen::Vector3d>(
-      "nonholonomic_point_body_m",
-      c.lever_arm_body_m - Eigen::Vector3d(0.0, 0.0, c.wheel_radius_m));
+  c.nonholonomic_point_body_m =
+      node.Get<Eigen::Vector3d>("nonholonomic_point_body_m",
+                                c.lever_arm_body_m - Eigen::Vector3d(0.0, 0.0, c.wheel_radius_m));
   c.yaw_scrub_factor = node.Get<double>("yaw_scrub_factor", c.yaw_scrub_factor);
   c.slip_ratio_base = node.Get<double>("slip_ratio_base", c.slip_ratio_base);
-  c.slip_ratio_per_tilt_rad = node.Get<double>("slip_ratio_per_tilt_rad", c.slip_ratio_per_tilt_rad);
+  c.slip_ratio_per_tilt_rad =
+      node.Get<double>("slip_ratio_per_tilt_rad", c.slip_ratio_per_tilt_rad);
   if (const std::optional<FieldProblem> problem = c.Problem()) {
     node.Fail(problem->field, problem->message);
   }

@@ -19,11 +19,9 @@ EskfOptions FromCalibrationAlone(const calib::BoardCalibration& calibration) {
   };
   set_if_positive(imu.rate_hz, &o.imu.rate_hz);
   set_if_positive(imu.gyro_noise_density_rad_s_sqrt_hz, &o.imu.gyro_noise_density_rad_s_sqrt_hz);
-  set_if_positive(imu.gyro_random_walk_rad_s2_sqrt_hz,
-                  &o.imu.gyro_bias_random_walk_rad_s2_sqrt_hz);
+  set_if_positive(imu.gyro_random_walk_rad_s2_sqrt_hz, &o.imu.gyro_bias_random_walk_rad_s2_sqrt_hz);
   set_if_positive(imu.accel_noise_density_m_s2_sqrt_hz, &o.imu.accel_noise_density_m_s2_sqrt_hz);
-  set_if_positive(imu.accel_random_walk_m_s3_sqrt_hz,
-                  &o.imu.accel_bias_random_walk_m_s3_sqrt_hz);
+  set_if_positive(imu.accel_random_walk_m_s3_sqrt_hz, &o.imu.accel_bias_random_walk_m_s3_sqrt_hz);
   o.clones.max_clones = kMaxClones;
   o.wheels.enabled = calibration.wheels.has_value();
   if (const std::optional<calib::WheelCalibration>& w = calibration.wheels) {

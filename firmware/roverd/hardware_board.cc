@@ -19,7 +19,6 @@
 namespace rover::roverd {
 namespace {
 
-
 // "400 Hz", "409.6 Hz": rates as a user wrote them.
 std::string Hz(double rate_hz) {
   char text[32];

@@ -4,22 +4,22 @@
 #include <memory>
 #include <numbers>
 
+#include "core/cli/report_format.h"
 #include "core/geometry/so3.h"
 #include "core/geometry/yaw.h"
 #include "core/stats/chi_square.h"
 #include "estimator/eval/eval_error.h"
 #include "estimator/eval/tum_trajectory.h"
-#include "core/cli/report_format.h"
 
 namespace rover::host::eval {
 
 using cli::Fixed;
 using cli::General;
-using cli::TextTable;
+using cli::kExitBadInput;
+using cli::kExitOk;
 using cli::ResultLine;
 using cli::Subcommand;
-using cli::kExitOk;
-using cli::kExitBadInput;
+using cli::TextTable;
 namespace {
 
 namespace ev = rover::eval;

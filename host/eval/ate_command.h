@@ -7,15 +7,15 @@
 #include <ostream>
 #include <string>
 
+#include "core/cli/subcommand.h"
 #include "estimator/eval/trajectory_evaluation.h"
 #include "estimator/eval/trajectory_io.h"
-#include "core/cli/subcommand.h"
 
 namespace rover::host::eval {
 
-using cli::Subcommand;
-using cli::kExitOk;
 using cli::kExitBadInput;
+using cli::kExitOk;
+using cli::Subcommand;
 
 struct AteCommandOptions {
   std::string estimate_path;

@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "host/eval/ate_command.h"
 #include "core/cli/subcommand.h"
+#include "host/eval/ate_command.h"
 #include "host/eval/vio_command.h"
 
 int main(int argc, char** argv) {

@@ -5,9 +5,9 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/cli/report_format.h"
 #include "core/geometry/so3.h"
 #include "core/geometry/yaw.h"
-#include "core/cli/report_format.h"
 
 namespace rover::host::eval {
 

@@ -293,22 +293,21 @@ VioRun RunVioExperiment(const VioCommandOptions& options, std::ostream& err) {
   const ev::Trajectory truth = TruthTrajectory(data, run.truth_source);
 
   AidingStreams aiding;
-  const calib::BoardCalibration calibration =
-      RunCalibration(data, options, mav0, &aiding, &run);
+  const calib::BoardCalibration calibration = RunCalibration(data, options, mav0, &aiding, &run);
   run.filter_options =
       estimator::FilterOptionsFromCalibration(calibration, options.filter_config_path);
-  run.notes.push_back(
-      "filter: from the calibration (IMU rate and noise of " +
-      (mav0 / "imu0/sensor.yaml").string() + ", max_clones " +
-      std::to_string(estimator::kMaxClones) + ")" +
-      (options.filter_config_path.empty() ? std::string()
-                                          : ", then " + options.filter_config_path));
+  run.notes.push_back("filter: from the calibration (IMU rate and noise of " +
+                      (mav0 / "imu0/sensor.yaml").string() + ", max_clones " +
+                      std::to_string(estimator::kMaxClones) + ")" +
+                      (options.filter_config_path.empty()
+                           ? std::string()
+                           : ", then " + options.filter_config_path));
   if (!calibration.stereo) {
     throw drivers::DatasetError((mav0 / "cam0/sensor.yaml").string() +
                                 ": expected a stereo calibration, found none");
   }
-  const vo::StereoOdometryOptions vo_options = estimator::VoOptionsFromCalibration(
-      calibration.stereo->cam0.rate_hz, options.vo_config_path);
+  const vo::StereoOdometryOptions vo_options =
+      estimator::VoOptionsFromCalibration(calibration.stereo->cam0.rate_hz, options.vo_config_path);
   run.notes.push_back("VO: " +
                       (options.vo_config_path.empty() ? std::string("default options")
                                                       : "options from " + options.vo_config_path) +

@@ -40,12 +40,13 @@ namespace rover::host::eval {
 inline const std::vector<double> kVioRpeSegmentsM = {1.0, 5.0, 10.0, 20.0, 50.0};
 
 struct VioCommandOptions {
-  std::string dataset_dir;          ///< the folder holding mav0/
-  std::string truth_path;           ///< --gt: ground truth elsewhere (EuRoC or OpenVINS CSV)
-  std::string vo_config_path;       ///< StereoOdometryOptions YAML (empty: defaults)
-  std::string filter_config_path;   ///< EskfOptions YAML applied on top (empty: none)
-  double vo_latency_s = 0.1;        ///< capture to delivery of a VO result [s]
-  bool wheels = true;  ///< feed mav0/can0 wheel speeds if the dataset has them and their calibration
+  std::string dataset_dir;         ///< the folder holding mav0/
+  std::string truth_path;          ///< --gt: ground truth elsewhere (EuRoC or OpenVINS CSV)
+  std::string vo_config_path;      ///< StereoOdometryOptions YAML (empty: defaults)
+  std::string filter_config_path;  ///< EskfOptions YAML applied on top (empty: none)
+  double vo_latency_s = 0.1;       ///< capture to delivery of a VO result [s]
+  bool wheels =
+      true;  ///< feed mav0/can0 wheel speeds if the dataset has them and their calibration
   int max_frames = 0;               ///< process at most this many stereo frames (0: all)
   std::string trajectory_out_path;  ///< write the fused estimate here (EuRoC CSV)
   /// Write one CSV row per VO frame here: stamp, status, quality, stage times.

@@ -81,7 +81,7 @@ struct UnplacedSubmap {
 
 /// The placement of every submap of a set of mapd logs.
 struct SubmapPlacements {
-  double resolution_m = 0.0;  ///< the map's: the first submap's (mapd uses one for all)
+  double resolution_m = 0.0;            ///< the map's: the first submap's (mapd uses one for all)
   std::vector<SubmapPlacement> placed;  ///< in log, then submap order (the order mapd built them)
   std::vector<UnplacedSubmap> unplaced;
 };

@@ -68,7 +68,6 @@ FilterFeed::FilterFeed(const Scenario& scenario, uint64_t seed, const FilterFeed
                                 : trajectory.duration_s();
   end_ = start_ + Duration::FromSeconds(duration_s);
 
-
   // IMU samples, their truth and the driven distance (for frame switches).
   ImuModelOptions imu_options = scenario.imu;
   imu_options.seed = scenario.imu.seed ^ (seed * 0x9E3779B97F4A7C15ULL);

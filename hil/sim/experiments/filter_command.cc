@@ -15,23 +15,23 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/cli/report_format.h"
 #include "core/geometry/so3.h"
 #include "core/geometry/yaw.h"
 #include "estimator/eskf/eskf_health.h"
 #include "estimator/eval/trajectory_evaluation.h"
 #include "hil/sim/sensors/wheel_odometry_model.h"
-#include "core/cli/report_format.h"
 
 namespace rover::sim::experiments {
 
 using cli::Fixed;
 using cli::General;
-using cli::TextTable;
+using cli::kExitBadInput;
+using cli::kExitCheckFailed;
+using cli::kExitOk;
 using cli::ResultLine;
 using cli::Subcommand;
-using cli::kExitOk;
-using cli::kExitCheckFailed;
-using cli::kExitBadInput;
+using cli::TextTable;
 namespace {
 
 namespace ev = rover::eval;
@@ -295,8 +295,9 @@ uint64_t RunSeed(uint64_t base_seed, int run) { return base_seed + static_cast<u
 std::string WheelSeedNote(const SimSetup& setup, const sim::Scenario& scenario) {
   if (!setup.wheels) return "";
   const sim::WheelOdometryModelOptions wheels =
-      scenario.wheels_config.empty() ? sim::WheelOdometryModelOptions{}
-                                     : sim::WheelOdometryModelOptions::LoadFile(scenario.wheels_config);
+      scenario.wheels_config.empty()
+          ? sim::WheelOdometryModelOptions{}
+          : sim::WheelOdometryModelOptions::LoadFile(scenario.wheels_config);
   std::string where = scenario.wheels_config.empty() ? "the default" : scenario.wheels_config;
   return "note: the wheel model's slip, velocity-noise and CAN-timing streams are seeded by " +
          where + " (seed " + std::to_string(wheels.seed) +

@@ -24,19 +24,19 @@
 #include <string>
 #include <vector>
 
+#include "core/cli/subcommand.h"
 #include "estimator/eskf/eskf_options.h"
 #include "estimator/eval/trajectory.h"
 #include "hil/sim/estimator_feed/filter_feed.h"
 #include "hil/sim/estimator_feed/filter_run.h"
 #include "hil/sim/scenario/scenario.h"
-#include "core/cli/subcommand.h"
 
 namespace rover::sim::experiments {
 
-using cli::Subcommand;
-using cli::kExitOk;
-using cli::kExitCheckFailed;
 using cli::kExitBadInput;
+using cli::kExitCheckFailed;
+using cli::kExitOk;
+using cli::Subcommand;
 
 /// What to simulate and how to configure the filter (shared by sim and nees).
 struct SimSetup {

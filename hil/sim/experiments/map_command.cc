@@ -22,9 +22,9 @@
 
 namespace rover::sim::experiments {
 
-using cli::Subcommand;
-using cli::kExitOk;
 using cli::kExitBadInput;
+using cli::kExitOk;
+using cli::Subcommand;
 namespace {
 
 // What the mission log tells about the run.

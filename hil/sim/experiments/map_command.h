@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "hil/sim/experiments/map_evaluation.h"
 #include "core/cli/subcommand.h"
+#include "hil/sim/experiments/map_evaluation.h"
 
 namespace rover::sim::experiments {
 
-using cli::Subcommand;
 using cli::kExitBadInput;
+using cli::Subcommand;
 
 struct MapCommandOptions {
   std::string mission_log;

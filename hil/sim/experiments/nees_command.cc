@@ -9,20 +9,20 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/cli/report_format.h"
 #include "core/stats/chi_square.h"
 #include "estimator/eval/eval_error.h"
-#include "core/cli/report_format.h"
 
 namespace rover::sim::experiments {
 
 using cli::Fixed;
 using cli::General;
-using cli::TextTable;
+using cli::kExitBadInput;
+using cli::kExitCheckFailed;
+using cli::kExitOk;
 using cli::ResultLine;
 using cli::Subcommand;
-using cli::kExitOk;
-using cli::kExitCheckFailed;
-using cli::kExitBadInput;
+using cli::TextTable;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

@@ -44,15 +44,15 @@
 #include <ostream>
 #include <vector>
 
-#include "hil/sim/experiments/filter_command.h"
 #include "core/cli/subcommand.h"
+#include "hil/sim/experiments/filter_command.h"
 
 namespace rover::sim::experiments {
 
-using cli::Subcommand;
-using cli::kExitOk;
-using cli::kExitCheckFailed;
 using cli::kExitBadInput;
+using cli::kExitCheckFailed;
+using cli::kExitOk;
+using cli::Subcommand;
 
 struct NeesCommandOptions {
   /// The default is the setup whose simulated sensors the filter models best:

@@ -71,7 +71,8 @@ void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
     if (options.mapd_logs.empty())
       throw std::runtime_error("mapd wrote no log in " + map_dir.string());
     std::cout << "map (rover-sim map " << options.mission_log << "):\n";
-    const rover::sim::experiments::MapResult r = rover::sim::experiments::EvaluateMission(options, std::cout);
+    const rover::sim::experiments::MapResult r =
+        rover::sim::experiments::EvaluateMission(options, std::cout);
     std::cout << line << " " << rover::sim::experiments::MapResultFields(r) << "\n";
   } catch (const std::exception& e) {
     Say("map evaluation: " + std::string(e.what()));

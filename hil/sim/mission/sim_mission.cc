@@ -10,9 +10,9 @@
 #include <thread>
 
 #include "drivers/replay/euroc_replay.h"
+#include "estimator/feed/filter_options.h"
 #include "firmware/roverd/roverd_process.h"
 #include "firmware/roverd/roverd_summary.h"
-#include "estimator/feed/filter_options.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/estimator_feed/filter_run.h"
 #include "hil/sim/live/sim_camera_trigger.h"

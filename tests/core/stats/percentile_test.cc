@@ -14,7 +14,7 @@ TEST(PercentileTest, InterpolatesBetweenClosestRanks) {
   const std::vector<double> v = {4.0, 1.0, 3.0, 2.0};  // sorted: 1 2 3 4
   EXPECT_DOUBLE_EQ(Percentile(v, 0.0), 1.0);
   EXPECT_DOUBLE_EQ(Percentile(v, 100.0), 4.0);
-  EXPECT_DOUBLE_EQ(Percentile(v, 50.0), 2.5);  // rank 1.5
+  EXPECT_DOUBLE_EQ(Percentile(v, 50.0), 2.5);   // rank 1.5
   EXPECT_DOUBLE_EQ(Percentile(v, 25.0), 1.75);  // rank 0.75
   EXPECT_DOUBLE_EQ(Percentile(v, 99.0), 3.97);  // rank 2.97
 }

@@ -70,11 +70,10 @@ TEST(DecodeWheelSpeedsTest, NeedsAllFourDrivesAndIgnoresHeartbeats) {
   std::vector<CanFrame> frames;
   frames.push_back(EncodeSync(t));
   for (uint8_t node = 1; node <= 4; ++node) {
-    frames.push_back(EncodeWheelTpdo1(t + Duration::Microseconds(200 * node),
-                                               {node, 1000 * node - 2500, 7}));
+    frames.push_back(
+        EncodeWheelTpdo1(t + Duration::Microseconds(200 * node), {node, 1000 * node - 2500, 7}));
   }
-  frames.push_back(
-      EncodeHeartbeat(t + Duration::Milliseconds(2), {2, kNmtOperational}));
+  frames.push_back(EncodeHeartbeat(t + Duration::Milliseconds(2), {2, kNmtOperational}));
   const Time t2 = t + Duration::Milliseconds(10);
   frames.push_back(EncodeSync(t2));
   frames.push_back(EncodeWheelTpdo1(t2 + Duration::Microseconds(200), {1, 5, 0}));

@@ -86,9 +86,9 @@ TEST(FilterOptionsFromCalibrationTest, WheelsOnWithTheCalibratedGeometry) {
 
   // A file that switches the wheels off wins; one that does not keeps them.
   testing::TempDir dir;
-  EXPECT_FALSE(FilterOptionsFromCalibration(
-                   c, WriteFile(dir, "off.yaml", "wheels:\n  enabled: false\n"))
-                   .wheels.enabled);
+  EXPECT_FALSE(
+      FilterOptionsFromCalibration(c, WriteFile(dir, "off.yaml", "wheels:\n  enabled: false\n"))
+          .wheels.enabled);
   const EskfOptions kept =
       FilterOptionsFromCalibration(c, WriteFile(dir, "track.yaml", "wheels:\n  track_m: 0.6\n"));
   EXPECT_TRUE(kept.wheels.enabled);

@@ -43,12 +43,10 @@ std::string Kinds(const std::vector<EskfInput>& inputs) {
 }
 
 TEST(InputOrderTest, EqualStampsGoImuWheelTriggerRelativePoseRequests) {
-  std::vector<EskfInput> in = {PoseReportRequest{Ms(5), 1}, FrameSwitchRequest{Ms(5)},
-                               Pose(Ms(5)),
-                               CloneTrigger{Ms(5)},
-                               WheelSpeedMeasurement{Ms(5), {}},
-                               Imu(5),
-                               CloneTrigger{Ms(4)}};
+  std::vector<EskfInput> in = {
+      PoseReportRequest{Ms(5), 1}, FrameSwitchRequest{Ms(5)},        Pose(Ms(5)),
+      CloneTrigger{Ms(5)},         WheelSpeedMeasurement{Ms(5), {}}, Imu(5),
+      CloneTrigger{Ms(4)}};
   SortInputs(&in);
   EXPECT_EQ(Kinds(in), "TIWTRSP");
   EXPECT_EQ(StampOf(in.front()), Ms(4));
@@ -86,7 +84,7 @@ TEST(InputMergerTest, LateInputsAreFedBeforeTheNextSampleAndCounted) {
   std::vector<EskfInput> fed;
   const auto feed = [&](const EskfInput& in) { fed.push_back(in); };
   merger.Step(Imu(10), feed);
-  ASSERT_TRUE(merger.Push(Pose(Ms(7))));  // before 10 ms: late
+  ASSERT_TRUE(merger.Push(Pose(Ms(7))));           // before 10 ms: late
   ASSERT_TRUE(merger.Push(CloneTrigger{Ms(10)}));  // at the last sample's stamp: not late
   fed.clear();
   merger.Step(Imu(15), feed);
@@ -135,11 +133,21 @@ TEST(InputMergerTest, AgreesWithTheGlobalSortOnRandomStreams) {
     for (int i = 0; i < 300; ++i) {
       const Time t = Ms(static_cast<int64_t>(rng() % 500));  // many equal stamps
       switch (rng() % 5) {
-        case 0: aiding.emplace_back(WheelSpeedMeasurement{t, {}}); break;
-        case 1: aiding.emplace_back(CloneTrigger{t}); break;
-        case 2: aiding.emplace_back(Pose(t)); break;
-        case 3: aiding.emplace_back(FrameSwitchRequest{t}); break;
-        default: aiding.emplace_back(PoseReportRequest{t, rng() % 100}); break;
+        case 0:
+          aiding.emplace_back(WheelSpeedMeasurement{t, {}});
+          break;
+        case 1:
+          aiding.emplace_back(CloneTrigger{t});
+          break;
+        case 2:
+          aiding.emplace_back(Pose(t));
+          break;
+        case 3:
+          aiding.emplace_back(FrameSwitchRequest{t});
+          break;
+        default:
+          aiding.emplace_back(PoseReportRequest{t, rng() % 100});
+          break;
       }
     }
     std::vector<EskfInput> all = aiding;

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "core/stats/chi_square.h"
-#include "hil/sim/experiments/nees_command.h"
-#include "hil/sim/experiments/filter_command.h"
 #include "core/cli/subcommand.h"
+#include "core/stats/chi_square.h"
+#include "hil/sim/experiments/filter_command.h"
+#include "hil/sim/experiments/nees_command.h"
 
 namespace rover::sim::experiments {
 namespace {

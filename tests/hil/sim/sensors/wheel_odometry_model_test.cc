@@ -38,7 +38,8 @@ std::vector<drivers::CanFrame> RunAll(WheelOdometryModel& model, const RoverTraj
 }
 
 TEST(WheelOdometryModelTest, OptionsLoadFromShippedYaml) {
-  const WheelOdometryModelOptions o = WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
+  const WheelOdometryModelOptions o =
+      WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
   EXPECT_EQ(o.encoder_counts_per_motor_rev, 4096u);
   EXPECT_EQ(o.ticks_per_wheel_rev(), 409600.0);
   EXPECT_EQ(o.heartbeat_phase_s, Eigen::Vector4d(0.11, 0.37, 0.62, 0.88));
@@ -50,7 +51,8 @@ TEST(WheelOdometryModelTest, OptionsLoadFromShippedYaml) {
 TEST(WheelOdometryModelTest, FrameIdsAndTiming) {
   const Heightfield terrain = testing::MakeRoughTerrain();
   const RoverTrajectory tr(StraightRoute(4.0, 0.3), terrain);
-  const WheelOdometryModelOptions o = WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
+  const WheelOdometryModelOptions o =
+      WheelOdometryModelOptions::LoadFile(ConfigPath("wheels.yaml"));
   WheelOdometryModel model(o, tr, terrain, kStart);
   std::vector<drivers::CanFrame> frames;
   std::mt19937_64 rng(5);
