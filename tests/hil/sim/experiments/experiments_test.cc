@@ -98,7 +98,7 @@ NeesCommandOptions SmallNees(int runs) {
 // The consistency claim on a small subset: 4 runs of `short` with the
 // command's defaults; both Monte Carlo averages inside the 95 % bounds of
 // chi2(12)/4.
-TEST(RoverEvalNees, AverageNeesOfFourRunsInsideBounds) {
+TEST(RoverSimNees, AverageNeesOfFourRunsInsideBounds) {
   const NeesCommandOptions options = SmallNees(4);
   const Report r = Nees(options);
   ASSERT_EQ(r.status, kExitOk) << r.out << r.err;
@@ -126,7 +126,7 @@ TEST(RoverEvalNees, AverageNeesOfFourRunsInsideBounds) {
 
 // The check can fail: a filter told the VO is 10x more precise than it is
 // (covariance_inflation 0.1) is overconfident, far above the upper bound.
-TEST(RoverEvalNees, OverconfidentFilterFailsTheCheck) {
+TEST(RoverSimNees, OverconfidentFilterFailsTheCheck) {
   NeesCommandOptions options = SmallNees(2);
   options.setup.max_duration_s = 30.0;
   options.setup.vo_covariance_inflation = 0.1;
@@ -139,7 +139,7 @@ TEST(RoverEvalNees, OverconfidentFilterFailsTheCheck) {
 }
 
 // Same seed, same RESULT, whatever the number of threads; another seed differs.
-TEST(RoverEvalNees, DeterministicForAnyJobs) {
+TEST(RoverSimNees, DeterministicForAnyJobs) {
   NeesCommandOptions options = SmallNees(2);
   options.setup.max_duration_s = 20.0;
   options.jobs = 1;
@@ -153,7 +153,7 @@ TEST(RoverEvalNees, DeterministicForAnyJobs) {
   EXPECT_NE(LastLine(one.out), LastLine(other.out));
 }
 
-TEST(RoverEvalNees, BadOptions) {
+TEST(RoverSimNees, BadOptions) {
   NeesCommandOptions options = SmallNees(2);
   options.setup.scenario = "no-such-scenario";
   Report r = Nees(options);
@@ -167,7 +167,7 @@ TEST(RoverEvalNees, BadOptions) {
 }
 
 // The sim RESULT line: every field, in order, parseable; plausible values.
-TEST(RoverEvalSim, ResultLineOfShort) {
+TEST(RoverSimFilter, ResultLineOfShort) {
   FilterCommandOptions options;
   options.setup.scenario = "short";
   options.seed = 1;
@@ -201,7 +201,7 @@ TEST(RoverEvalSim, ResultLineOfShort) {
 
 // Several runs: the means, identical with one or two threads; a route too
 // short for every RPE segment gives "nan", never a missing field.
-TEST(RoverEvalSim, SeveralRunsDeterministicAndNanForMissingRpe) {
+TEST(RoverSimFilter, SeveralRunsDeterministicAndNanForMissingRpe) {
   FilterCommandOptions options;
   options.setup.scenario = "short";
   options.setup.max_duration_s = 15.0;
@@ -223,7 +223,7 @@ TEST(RoverEvalSim, SeveralRunsDeterministicAndNanForMissingRpe) {
   EXPECT_THAT(one.out, Not(HasSubstr("note: the wheel model's")));
 }
 
-TEST(RoverEvalSim, UnknownScenarioIsBadInput) {
+TEST(RoverSimFilter, UnknownScenarioIsBadInput) {
   FilterCommandOptions options;
   options.setup.scenario = "no-such-scenario";
   const Report r = Sim(options);
@@ -232,7 +232,7 @@ TEST(RoverEvalSim, UnknownScenarioIsBadInput) {
 }
 
 // The command lines: options reach the runs, bad values are parse errors.
-TEST(RoverEvalSimCommandLine, NeesAndSimParseTheirOptions) {
+TEST(RoverSimExperimentsCommandLine, NeesAndFilterParseTheirOptions) {
   {
     CLI::App app;
     AddNeesCommand(app);
@@ -241,7 +241,7 @@ TEST(RoverEvalSimCommandLine, NeesAndSimParseTheirOptions) {
   {
     CLI::App app;
     AddFilterCommand(app);
-    EXPECT_THROW(app.parse("sim --wheels maybe"), CLI::ValidationError);
+    EXPECT_THROW(app.parse("filter --wheels maybe"), CLI::ValidationError);
   }
   {
     CLI::App app;
@@ -263,7 +263,7 @@ TEST(RoverEvalSimCommandLine, NeesAndSimParseTheirOptions) {
   {
     CLI::App app;
     const Subcommand sim = AddFilterCommand(app);
-    app.parse("sim --scenario short --seed 2 --duration-s 5 --wheels off --segments 1,2");
+    app.parse("filter --scenario short --seed 2 --duration-s 5 --wheels off --segments 1,2");
     ASSERT_TRUE(sim.app->parsed());
     ::testing::internal::CaptureStdout();
     const int status = sim.run();
