@@ -17,7 +17,6 @@ namespace {
 
 namespace ev = rover::eval;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Confidence of the NEES bounds.
 constexpr double kNeesConfidence = 0.95;
 

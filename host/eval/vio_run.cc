@@ -30,7 +30,6 @@ namespace fs = std::filesystem;
 using cli::Fixed;
 using cli::General;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Ground-truth samples further apart than this are not interpolated across
 // (EuRoC's own ground truth is at 200 Hz, the OpenVINS CSVs at 20 Hz).
 constexpr Duration kTruthMaxGap = Duration::Milliseconds(100);
