@@ -4,8 +4,12 @@ namespace rover::roverd {
 
 bool LockstepGate::ImuMayStep(Time t) const {
   if (stopped_) return true;
+  // Every frame captured by t has had its clone trigger handed over: the
+  // camera is past t, or holds a frame captured after t. (This also means
+  // no frame the VO owes a result for by t can still come.)
+  const bool camera_ok = !camera_ || camera_ended_ || camera_through_ >= t ||
+                         (camera_holding_ && camera_held_stamp_ > t);
   const Time due = t - vo_latency_;
-  const bool camera_ok = !camera_ || camera_ended_ || camera_through_ > due;
   const bool vo_ok = frames_in_flight_.empty() || frames_in_flight_.front() > due;
   const bool can_ok =
       !can_ || can_ended_ || can_through_ >= t || (can_holding_ && can_held_stamp_ > t);
@@ -21,6 +25,9 @@ void LockstepGate::WaitBeforeImu(Time t) {
 
 void LockstepGate::FrameArrived(Time capture) {
   std::unique_lock lock(mutex_);
+  camera_holding_ = true;
+  camera_held_stamp_ = capture;
+  changed_.notify_all();
   changed_.wait(lock, [&] { return stopped_ || capture <= imu_target_ + lead_; });
 }
 
@@ -28,6 +35,7 @@ void LockstepGate::FrameQueued(Time capture) {
   {
     const std::lock_guard lock(mutex_);
     frames_in_flight_.push_back(capture);
+    camera_holding_ = false;
     camera_through_ = capture;
   }
   changed_.notify_all();
@@ -36,6 +44,7 @@ void LockstepGate::FrameQueued(Time capture) {
 void LockstepGate::FrameSkipped(Time capture) {
   {
     const std::lock_guard lock(mutex_);
+    camera_holding_ = false;
     camera_through_ = capture;
   }
   changed_.notify_all();

@@ -4,9 +4,11 @@
 // Couples roverd's threads when the sensors run faster than real time
 // (simulation in lockstep, tests): the IMU thread steps the filter to time t
 // only when every input due by t has been handed over, i.e.
+//   - the camera has handed over every frame captured at or before t (each
+//     frame's clone trigger is an input at its capture time): it is past t,
+//     or holds a frame captured after t;
 //   - the VO has finished every frame captured at or before t - vo_latency
-//     (its result is delivered at capture + vo_latency), and the camera has
-//     produced a frame after that point (so no earlier one can still come);
+//     (its result is delivered at capture + vo_latency);
 //   - the CAN thread has handed over a frame stamped at or after t, or holds
 //     one stamped after t.
 // The camera and CAN threads in turn stay at most `lead` ahead of the time
@@ -33,8 +35,8 @@ class LockstepGate {
   /// IMU thread: announces that it steps to `t` next and blocks until
   /// everything due by `t` is handed over (or Stop()).
   void WaitBeforeImu(Time t);
-  /// Camera thread: blocks while a frame captured at `capture` is more than
-  /// `lead` ahead of the time the IMU thread is stepping to.
+  /// Camera thread: a frame captured at `capture` arrived; blocks while it is
+  /// more than `lead` ahead of the time the IMU thread is stepping to.
   void FrameArrived(Time capture);
   /// Camera thread: a frame captured at `capture` goes to the VO.
   void FrameQueued(Time capture);
@@ -73,6 +75,8 @@ class LockstepGate {
   bool imu_ended_ = false;
   std::deque<Time> frames_in_flight_;
   Time camera_through_ = Time::FromNanoseconds(INT64_MIN / 2);
+  bool camera_holding_ = false;  // a received frame waits to be handed over
+  Time camera_held_stamp_;
   bool camera_ended_ = false;
   Time can_through_ = Time::FromNanoseconds(INT64_MIN / 2);
   bool can_holding_ = false;  // a received frame waits to be handed over

@@ -53,7 +53,11 @@ fs::path RunRoverd(const fs::path& dir) {
                                     .output_file = output.string()});
   const auto status = p.WaitFor(Duration::Seconds(300));
   const runtime::ExitStatus exit = status.value_or(p.Terminate(Duration::Seconds(1)));
-  EXPECT_TRUE(exit.ok()) << exit.Describe() << "\n" << testing::ReadTextFile(output);
+  const std::string text = testing::ReadTextFile(output);
+  EXPECT_TRUE(exit.ok()) << exit.Describe() << "\n" << text;
+  // In lockstep every input is handed over before the filter passes its
+  // stamp; a late one would be applied out of order and break the identity.
+  EXPECT_NE(text.find("late inputs 0,"), std::string::npos) << text;
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(logs)) files.push_back(e.path());
   EXPECT_EQ(files.size(), 1u);
