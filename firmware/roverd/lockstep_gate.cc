@@ -60,12 +60,12 @@ void LockstepGate::FrameDone() {
 
 void LockstepGate::WaitForImuAt(Time capture) {
   std::unique_lock lock(mutex_);
-  // The IMU thread waits for this frame's result once it steps past
-  // capture + vo_latency: then it has stepped everything up to the capture
-  // already unless the latency is shorter than an IMU period; either way
-  // going on cannot deadlock.
+  // The IMU thread announces its next sample only once the previous one is
+  // stepped, so a target after the capture means every sample up to the
+  // capture is done. Waiting for more could deadlock: the IMU thread may be
+  // waiting for the camera, and the camera for a slot this frame holds.
   changed_.wait(lock, [&] {
-    return stopped_ || imu_ended_ || imu_done_ >= capture || imu_target_ - vo_latency_ >= capture;
+    return stopped_ || imu_ended_ || imu_done_ >= capture || imu_target_ > capture;
   });
 }
 

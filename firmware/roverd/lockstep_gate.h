@@ -45,7 +45,7 @@ class LockstepGate {
   /// VO thread: the oldest queued frame is done (its result handed over).
   void FrameDone();
   /// VO thread: blocks until the IMU thread has stepped every sample up to
-  /// `capture` (or ended, or waits for this frame's result itself).
+  /// `capture` (it has announced a later sample, or ended).
   void WaitForImuAt(Time capture);
   /// IMU thread: the sample at `t` is stepped and its state published.
   void ImuStepped(Time t);

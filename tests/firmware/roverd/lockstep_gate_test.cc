@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <future>
 #include <thread>
 
 namespace rover::roverd {
@@ -54,6 +55,22 @@ TEST(LockstepGateTest, ImuWaitsForTheVoResultDueByItsStep) {
   EXPECT_TRUE(done.load()) << "the IMU stepped to capture + latency without the VO result";
   camera.join();
   vo.join();
+}
+
+// A frame captured between two IMU samples: once the IMU thread announces
+// the sample after the capture, the VO may read the filter as of the capture.
+// Asking for more would deadlock when the IMU thread waits for the camera and
+// the camera for the slot this frame holds.
+TEST(LockstepGateTest, VoGoesOnOnceTheImuAnnouncesASampleAfterTheCapture) {
+  LockstepGate gate(/*camera=*/false, /*can=*/false, Duration::Milliseconds(100),
+                    Duration::Seconds(1));
+  gate.WaitBeforeImu(Ms(50));
+  gate.ImuStepped(Ms(50));
+  gate.WaitBeforeImu(Ms(60));
+  auto vo = std::async(std::launch::async, [&] { gate.WaitForImuAt(Ms(55)); });
+  const bool returned = vo.wait_for(std::chrono::seconds(10)) == std::future_status::ready;
+  gate.Stop();
+  EXPECT_TRUE(returned) << "the VO waited for a sample after the capture to be stepped";
 }
 
 }  // namespace
