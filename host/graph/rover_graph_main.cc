@@ -73,6 +73,16 @@ int main(int argc, char** argv) {
   solve->add_option("--max-iterations", solve_options.solver.max_iterations, "Ceres iterations")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  solve
+      ->add_option("--function-tolerance", solve_options.solver.function_tolerance,
+                   "Ceres: stop on a relative cost decrease below this")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  solve
+      ->add_option("--gradient-tolerance", solve_options.solver.gradient_tolerance,
+                   "Ceres: stop on a gradient max-norm below this")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   solve->add_option("--threads", solve_options.solver.num_threads, "Ceres threads")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();

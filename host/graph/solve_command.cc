@@ -63,6 +63,15 @@ int RunSolve(const SolveCommandOptions& options, std::ostream& out, std::ostream
       << Fixed(s.solve_time_s, 3) << " s, total " << Fixed(s.total_time_s, 3) << " s\n";
   out << "  initial cost " << Sci(s.initial_cost) << ", final cost " << Sci(s.final_cost) << '\n';
   out << "  F (SE-Sync objective) " << Sci(s.F) << ", chi2 " << Sci(s.chi2) << '\n';
+  if (!s.information.Describe().empty()) out << "  ignored: " << s.information.Describe() << '\n';
+  if (s.certificate) {
+    const mapping::SeSyncCertificate& c = *s.certificate;
+    out << "  certificate: " << (c.certified ? "certified" : "not certified") << " (lambda_min "
+        << Sci(c.lambda_min) << ", tolerance -" << Sci(c.eta) << "), suboptimality bound "
+        << Sci(c.suboptimality_bound) << ", dual bound " << Sci(c.dual_bound) << ", gradient norm "
+        << Sci(c.gradient_norm) << ", " << c.factorisations << " factorisations, " << c.iterations
+        << " eigen iterations, " << Fixed(c.time_s, 3) << " s\n";
+  }
   if (solver.outliers != mapping::OutlierHandling::kNone) {
     out << "  loop closures " << s.loop_closures << ", rejected " << s.rejected << '\n';
   }

@@ -74,7 +74,11 @@ class LineParser {
     return q.normalized();
   }
 
-  // Reads n*(n+1)/2 upper-triangular entries, row by row.
+  // Reads n*(n+1)/2 upper-triangular entries, row by row. The translation
+  // block (first N/2 rows: x, y[, z]) and the rotation block (the rest) must
+  // each be positive definite: every objective needs them. The matrix as a
+  // whole may be indefinite (some published datasets carry such matrices);
+  // whether that is acceptable depends on the objective (CheckInformation).
   template <int N>
   Eigen::Matrix<double, N, N> UpperTriangular(size_t first) const {
     Eigen::Matrix<double, N, N> I;
@@ -84,16 +88,23 @@ class LineParser {
         I(r, c) = I(c, r) = Number(k++, "an information entry");
       }
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(I);
+    constexpr int kTranslation = N == 6 ? 3 : 2;
+    ExpectPositiveDefinite(I.topLeftCorner(kTranslation, kTranslation),
+                           N == 6 ? "translation block (x, y, z)" : "translation block (x, y)");
+    ExpectPositiveDefinite(I.bottomRightCorner(N - kTranslation, N - kTranslation),
+                           N == 6 ? "rotation block (qx, qy, qz)" : "rotation entry (theta)");
+    return I;
+  }
+
+  void ExpectPositiveDefinite(const Eigen::MatrixXd& block, const char* what) const {
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(block);
     const double min_eigenvalue = eig.eigenvalues()(0);
     if (!(min_eigenvalue > 0.0)) {
       std::ostringstream os;
-      os << "expected a positive-definite information matrix, found one with smallest "
-            "eigenvalue "
-         << min_eigenvalue;
+      os << "expected a positive-definite " << what
+         << " of the information matrix, found one with smallest eigenvalue " << min_eigenvalue;
       Fail(os.str());
     }
-    return I;
   }
 
  private:

@@ -17,9 +17,13 @@ namespace rover::mapping {
 /// Reads the g2o file at `path`. Throws GraphError "path:line: expected ...,
 /// found ..." for a malformed line (unknown tag, missing or non-numeric
 /// field, NaN/infinite value, zero quaternion, 2D and 3D records mixed), an
-/// information matrix that is not positive definite, a duplicate vertex, a
+/// information matrix whose translation or rotation block is not positive
+/// definite, a duplicate vertex, a
 /// self-loop edge, or an edge referencing a vertex that no VERTEX line
-/// defines (when the file has VERTEX lines). Quaternions are normalised.
+/// defines (when the file has VERTEX lines). Quaternions are normalised. A
+/// matrix that is indefinite only as a whole (through its rotation-translation
+/// off-diagonal block) is read: the SE-Sync objective uses the two diagonal
+/// blocks only; CheckInformation refuses it for chi2.
 PoseGraph ReadG2oFile(const std::string& path);
 
 /// As ReadG2oFile, from a stream; `source_name` stands for the file name in

@@ -240,6 +240,7 @@ HelmertBlockSolver::HelmertBlockSolver(HelmertBlockOptions options)
 
 HelmertBlockSummary HelmertBlockSolver::Solve(PoseGraph& graph) const {
   CheckGaugeAndFinite(graph);
+  (void)CheckInformation(graph, options_.objective);
   const Clock::time_point start = Clock::now();
   HelmertBlockSummary out;
   const Model model(graph, options_.objective);

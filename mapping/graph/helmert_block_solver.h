@@ -86,7 +86,8 @@ class HelmertBlockSolver {
   explicit HelmertBlockSolver(HelmertBlockOptions options);
 
   /// Optimises graph.vertices in place (first vertex fixed). Throws GraphError
-  /// for gauge/NaN problems (CheckGaugeAndFinite) or a singular system.
+  /// for gauge/NaN problems (CheckGaugeAndFinite), an information matrix the
+  /// objective cannot use (CheckInformation) or a singular system.
   HelmertBlockSummary Solve(PoseGraph& graph) const;
 
  private:

@@ -2,12 +2,16 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
 #include "core/stats/chi_square.h"
@@ -191,6 +195,68 @@ class Problem {
 
 bool IsLoopClosure(const PoseEdge& edge) { return std::llabs(edge.to - edge.from) != 1; }
 
+std::string InformationUse::Describe() const {
+  if (off_diagonal_ignored == 0) return "";
+  std::ostringstream os;
+  os << off_diagonal_ignored << (off_diagonal_ignored == 1 ? " edge" : " edges")
+     << ": off-diagonal blocks ignored";
+  if (indefinite > 0) {
+    os << "; " << indefinite << " of them"
+       << ": info matrix indefinite as a whole";
+    if (first_indefinite_line > 0) os << " (first on line " << first_indefinite_line << ")";
+  }
+  return os.str();
+}
+
+namespace {
+
+// The information matrix an edge's chi2 residual weights: 6x6 in 3D, the
+// (x, y, theta) 3x3 in 2D.
+Eigen::MatrixXd WeightedInformation(const PoseEdge& edge, int dimension) {
+  if (dimension == 2) return PlanarInformation(edge.information);
+  return edge.information;
+}
+
+bool HasOffDiagonalBlock(const Eigen::MatrixXd& information) {
+  const int t = information.rows() == 6 ? 3 : 2;
+  return !information.topRightCorner(t, information.cols() - t).isZero(0.0);
+}
+
+}  // namespace
+
+InformationUse CheckInformation(const PoseGraph& graph, Objective objective) {
+  InformationUse use;
+  int first_bad = -1;
+  double first_bad_eigenvalue = 0.0;
+  for (size_t k = 0; k < graph.edges.size(); ++k) {
+    const Eigen::MatrixXd I = WeightedInformation(graph.edges[k], graph.dimension);
+    if (!HasOffDiagonalBlock(I)) continue;  // Diagonal blocks are positive definite.
+    ++use.off_diagonal_ignored;
+    if (Eigen::LLT<Eigen::MatrixXd>(I).info() == Eigen::Success) continue;
+    ++use.indefinite;
+    if (first_bad < 0) {
+      first_bad = static_cast<int>(k);
+      first_bad_eigenvalue = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(I).eigenvalues()(0);
+      use.first_indefinite_line = graph.edges[k].line;
+    }
+  }
+  if (objective == Objective::kChi2 && first_bad >= 0) {
+    const PoseEdge& e = graph.edges[static_cast<size_t>(first_bad)];
+    std::ostringstream os;
+    os << graph.source << ":"
+       << (e.line > 0 ? std::to_string(e.line) : "edge " + std::to_string(first_bad)) << ": edge "
+       << e.from << " -> " << e.to
+       << ": expected a positive-definite information matrix for the chi2 objective, found "
+          "smallest eigenvalue "
+       << first_bad_eigenvalue;
+    if (use.indefinite > 1) os << " (and " << use.indefinite - 1 << " more such edges)";
+    os << "; the sesync objective uses only its rotation and translation blocks";
+    throw GraphError(os.str());
+  }
+  if (objective == Objective::kChi2) use.off_diagonal_ignored = 0;  // chi2 uses them.
+  return use;
+}
+
 PoseGraphSolverOptions PoseGraphSolverOptions::Load(const ConfigNode& node) {
   PoseGraphSolverOptions o;
   o.objective = node.GetEnum<Objective>(
@@ -309,6 +375,7 @@ std::vector<bool> RobustChordalInitialisation(PoseGraph& graph,
 PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options) {
   CheckGaugeAndFinite(graph);
   PoseGraphSolverSummary out;
+  out.information = CheckInformation(graph, options.objective);
   const Clock::time_point start = Clock::now();
   const bool file_has_guess = !graph.vertices_implied;
   out.inlier.assign(graph.edges.size(), true);
@@ -420,8 +487,13 @@ PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOpt
     problem.FromParameters();
   }
   out.solve_time_s = Seconds(solve_start);
-  out.total_time_s = Seconds(start);
   out.F = SeSyncObjective(graph);
+  if (options.certify && options.objective == Objective::kSeSync &&
+      options.outliers == OutlierHandling::kNone) {
+    const SeSyncRelaxation relaxation(graph);
+    out.certificate = relaxation.Certify(relaxation.Rotations(graph), out.F, options.certificate);
+  }
+  out.total_time_s = Seconds(start);
   out.chi2 = Chi2Objective(graph);
   return out;
 }

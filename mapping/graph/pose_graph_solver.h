@@ -7,11 +7,13 @@
 // graduated non-convexity), and the figures to compare with published results.
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/config/config.h"
 #include "mapping/graph/pose_graph.h"
+#include "mapping/graph/se_sync_certificate.h"
 
 namespace rover::mapping {
 
@@ -69,6 +71,10 @@ struct PoseGraphSolverOptions {
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
+  /// SE-Sync objective without outlier handling: compute SE-Sync's
+  /// optimality certificate of the solution (se_sync_certificate.h).
+  bool certify = true;
+  SeSyncCertificateOptions certificate;
   /// Called once per Ceres iteration with (iteration, cost, seconds since the
   /// solve started); may be empty.
   std::function<void(int, double, double)> progress;
@@ -83,25 +89,55 @@ struct PoseGraphSolverOptions {
   static PoseGraphSolverOptions Load(const ConfigNode& node);
 };
 
+/// What an objective leaves unused of the edges' information matrices.
+struct InformationUse {
+  /// Edges whose rotation-translation off-diagonal block is non-zero. The
+  /// SE-Sync objective reads only the diagonal blocks (kappa from the rotation
+  /// block, tau from the translation block, as SE-Sync does) and ignores it.
+  int off_diagonal_ignored = 0;
+  /// Of those, the edges whose matrix is indefinite as a whole (its diagonal
+  /// blocks are positive definite: the reader checks them).
+  int indefinite = 0;
+  /// Source line of the first indefinite edge (0 if none or not from a file).
+  int first_indefinite_line = 0;
+
+  /// "" if nothing is ignored, else e.g. "12 edges: off-diagonal blocks
+  /// ignored; 3 of them: info matrix indefinite as a whole (first on line 40)".
+  std::string Describe() const;
+};
+
+/// Checks every edge's information matrix against what `objective` uses.
+/// chi2 weights the whole matrix, so it must be positive definite: throws
+/// GraphError "FILE:LINE: edge I -> J: expected a positive-definite
+/// information matrix for the chi2 objective, found smallest eigenvalue X"
+/// for the first edge that is not (with the count of the others). sesync uses
+/// only the diagonal blocks: returns what it ignores, never throws.
+InformationUse CheckInformation(const PoseGraph& graph, Objective objective);
+
 struct PoseGraphSolverSummary {
-  int iterations = 0;         ///< Ceres iterations (summed over GNC steps).
-  double init_time_s = 0.0;   ///< Initialisation wall time.
-  double solve_time_s = 0.0;  ///< Nonlinear refinement wall time.
-  double total_time_s = 0.0;  ///< Both.
-  double initial_cost = 0.0;  ///< Ceres cost (0.5 sum rho(|r|^2)) after init.
-  double final_cost = 0.0;    ///< Ceres cost at the end.
-  double F = 0.0;             ///< SE-Sync objective at the solution (all edges).
-  double chi2 = 0.0;          ///< g2o chi2 at the solution (all edges).
-  bool converged = false;     ///< Ceres reported convergence.
-  int loop_closures = 0;      ///< Edges with |to - from| != 1.
-  int rejected = 0;           ///< Loop closures classified as outliers.
-  std::vector<bool> inlier;   ///< Per edge: kept (true) or rejected.
-  std::string message;        ///< Ceres termination message.
+  int iterations = 0;          ///< Ceres iterations (summed over GNC steps).
+  double init_time_s = 0.0;    ///< Initialisation wall time.
+  double solve_time_s = 0.0;   ///< Nonlinear refinement wall time.
+  double total_time_s = 0.0;   ///< Both.
+  double initial_cost = 0.0;   ///< Ceres cost (0.5 sum rho(|r|^2)) after init.
+  double final_cost = 0.0;     ///< Ceres cost at the end.
+  double F = 0.0;              ///< SE-Sync objective at the solution (all edges).
+  double chi2 = 0.0;           ///< g2o chi2 at the solution (all edges).
+  bool converged = false;      ///< Ceres reported convergence.
+  int loop_closures = 0;       ///< Edges with |to - from| != 1.
+  int rejected = 0;            ///< Loop closures classified as outliers.
+  std::vector<bool> inlier;    ///< Per edge: kept (true) or rejected.
+  std::string message;         ///< Ceres termination message.
+  InformationUse information;  ///< What the objective ignored of the information matrices.
+  /// SE-Sync's certificate of the solution (objective sesync, no outlier
+  /// handling, `certify`); its time is part of total_time_s.
+  std::optional<SeSyncCertificate> certificate;
 };
 
 /// Optimises the vertex poses of `graph` in place. The first vertex is held
 /// fixed (gauge). Throws GraphError for a gauge problem (several connected
-/// components) or NaN input, naming the vertices involved.
+/// components) or NaN input, naming the vertices involved, and for an
+/// information matrix the objective cannot use (CheckInformation).
 PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options);
 
 /// GNC initialisation used by OutlierHandling::kGnc: graduated
