@@ -61,6 +61,16 @@ int main(int argc, char** argv) {
                    "GNC: squared residual above which a loop closure is an outlier")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  std::string sesync_solver = "newton";
+  solve
+      ->add_option("--sesync-solver", sesync_solver,
+                   "sesync objective: newton (exact Hessian, quadratic convergence) or ceres "
+                   "(Gauss-Newton LM)")
+      ->check(CLI::IsMember({"newton", "ceres"}))
+      ->capture_default_str();
+  bool no_certificate = false;
+  solve->add_flag("--no-certificate", no_certificate,
+                  "sesync objective: skip SE-Sync's optimality certificate");
   std::string trust_region = "lm";
   solve->add_option("--trust-region", trust_region, "lm (Levenberg-Marquardt) or dogleg")
       ->check(CLI::IsMember({"lm", "dogleg"}))
@@ -107,6 +117,8 @@ int main(int argc, char** argv) {
     solve_options.solver.outliers = kOutliers.at(outliers);
     solve_options.progress = !quiet;
     solve_options.solver.dogleg = trust_region == "dogleg";
+    solve_options.solver.newton = sesync_solver == "newton";
+    solve_options.solver.certify = !no_certificate;
     return rover::host::RunSolve(solve_options, std::cout, std::cerr);
   }
   return 2;

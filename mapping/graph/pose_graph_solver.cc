@@ -22,6 +22,7 @@
 #include "mapping/graph/pose_manifold.h"
 #include "mapping/graph/relative_pose_2d_cost.h"
 #include "mapping/graph/relative_pose_3d_cost.h"
+#include "mapping/graph/se_sync_newton_solver.h"
 #include "mapping/graph/se_sync_objective.h"
 
 namespace rover::mapping {
@@ -276,6 +277,8 @@ PoseGraphSolverOptions PoseGraphSolverOptions::Load(const ConfigNode& node) {
   o.outlier_confidence =
       node.GetInRange<double>("outlier_confidence", 0.5, 1.0 - 1e-12, o.outlier_confidence);
   o.gnc_step = node.GetInRange<double>("gnc_step", 1.01, 10.0, o.gnc_step);
+  o.newton = node.GetEnum<bool>("sesync_solver", {{"newton", true}, {"ceres", false}}, o.newton);
+  o.certify = node.GetEnum<bool>("certify", {{"true", true}, {"false", false}}, o.certify);
   o.dogleg = node.GetEnum<bool>("trust_region", {{"lm", false}, {"dogleg", true}}, o.dogleg);
   o.initial_trust_region_radius = node.GetInRange<double>("initial_trust_region_radius", 1e-6, 1e16,
                                                           o.initial_trust_region_radius);
@@ -469,6 +472,23 @@ PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOpt
       run(problem, options.max_iterations);
       problem.FromParameters();
     }
+  } else if (options.newton && options.objective == Objective::kSeSync &&
+             options.outliers == OutlierHandling::kNone) {
+    SeSyncNewtonOptions newton;
+    newton.max_iterations = options.max_iterations;
+    if (options.progress) {
+      newton.progress = [&](int iteration, double cost, double) {
+        options.progress(iteration, cost, Seconds(start));
+      };
+    }
+    const SeSyncNewtonSummary s = SolveSeSyncNewton(graph, newton);
+    out.iterations = s.iterations;
+    out.initial_cost = s.initial_cost;
+    out.final_cost = s.final_cost;
+    out.converged = s.converged;
+    out.message = "Newton (exact Hessian): " + std::to_string(s.iterations) + " iterations, " +
+                  std::to_string(s.factorisations) + " factorisations, " + s.message +
+                  ", gradient max-norm " + std::to_string(s.gradient_max_norm);
   } else {
     Problem problem(graph, options);
     run(problem, options.max_iterations);

@@ -71,6 +71,10 @@ struct PoseGraphSolverOptions {
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
+  /// SE-Sync objective without outlier handling: refine with the exact-Hessian
+  /// Newton solver (se_sync_newton_solver.h; quadratic convergence) instead
+  /// of Ceres's Gauss-Newton LM (linear convergence on F).
+  bool newton = true;
   /// SE-Sync objective without outlier handling: compute SE-Sync's
   /// optimality certificate of the solution (se_sync_certificate.h).
   bool certify = true;
@@ -81,6 +85,7 @@ struct PoseGraphSolverOptions {
 
   /// Reads keys objective (chi2|sesync), initialisation (chordal|odometry|file),
   /// outliers (none|cauchy|gnc), trust_region (lm|dogleg),
+  /// sesync_solver (newton|ceres), certify (true|false),
   /// initial_trust_region_radius, cauchy_scale, gnc_threshold,
   /// outlier_confidence, gnc_step, sparse_library (auto|eigen),
   /// jacobi_scaling (true|false),
