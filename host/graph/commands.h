@@ -22,9 +22,13 @@ struct SolveCommandOptions {
 };
 
 /// `rover-graph solve IN.g2o OUT.g2o`: initialise, optimise, write OUT, print
-/// iterations, times, final cost, chi2 and the SE-Sync objective F, ending
-/// with one machine-readable line
+/// iterations, times, final cost, chi2 and the SE-Sync objective F, what the
+/// objective ignored of the information matrices ("ignored: ..."), and for
+/// the SE-Sync objective its optimality certificate ("certificate: certified
+/// (lambda_min ...)" or "not certified (lambda_min ...)", the suboptimality
+/// bound), ending with one machine-readable line
 ///   RESULT dataset=... objective=... iterations=... time_s=... final_cost=... F=... chi2=...
+///   converged=... rejected=... [certified=yes|no lambda_min=... suboptimality_bound=...]
 int RunSolve(const SolveCommandOptions& options, std::ostream& out, std::ostream& err);
 
 /// `rover-graph info IN.g2o`: dimension, vertex and edge counts, loop

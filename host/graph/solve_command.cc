@@ -79,7 +79,13 @@ int RunSolve(const SolveCommandOptions& options, std::ostream& out, std::ostream
       << " objective=" << (sesync ? "sesync" : "chi2") << " iterations=" << s.iterations
       << " time_s=" << Fixed(s.total_time_s, 4) << " final_cost=" << Sci(s.final_cost)
       << " F=" << Sci(s.F) << " chi2=" << Sci(s.chi2)
-      << " converged=" << (s.converged ? "yes" : "no") << " rejected=" << s.rejected << '\n';
+      << " converged=" << (s.converged ? "yes" : "no") << " rejected=" << s.rejected;
+  if (s.certificate) {
+    out << " certified=" << (s.certificate->certified ? "yes" : "no")
+        << " lambda_min=" << Sci(s.certificate->lambda_min)
+        << " suboptimality_bound=" << Sci(s.certificate->suboptimality_bound);
+  }
+  out << '\n';
   return 0;
 }
 

@@ -224,7 +224,11 @@ SeSyncCertificate SeSyncRelaxation::Certify(const Eigen::MatrixXd& Y, double F_e
   // positive definite: the inverse iteration needs a definite shifted S.
   double sigma = out.eta;
   out.certified = positive_definite_at(sigma);
+  // Not certified: lambda_min(S) <= -sigma_fail for the largest shift at
+  // which K was indefinite; the iteration must reach that far down.
+  double sigma_fail = 0.0;
   for (int k = 0; !out.certified && k < 60; ++k) {
+    sigma_fail = sigma;
     sigma *= 10.0;
     if (positive_definite_at(sigma)) break;
   }
@@ -247,6 +251,7 @@ SeSyncCertificate SeSyncRelaxation::Certify(const Eigen::MatrixXd& Y, double F_e
   }
   X = Orthonormalise(X);
   Eigen::VectorXd theta = Eigen::VectorXd::Zero(block);
+  double residual = 0.0;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(m + dn, block);
   for (out.iterations = 0; out.iterations < options.max_iterations;) {
     rhs.bottomRows(dn) = X;
@@ -257,8 +262,14 @@ SeSyncCertificate SeSyncRelaxation::Certify(const Eigen::MatrixXd& Y, double F_e
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (T + T.transpose()));
     theta = eig.eigenvalues();
     X = Z * eig.eigenvectors();
-    const double residual = (SZ * eig.eigenvectors().col(0) - theta(0) * X.col(0)).norm();
-    if (residual <= options.residual_tolerance * std::abs(theta(0)) + out.eta) break;
+    residual = (SZ * eig.eigenvectors().col(0) - theta(0) * X.col(0)).norm();
+    // Converged: theta(0) is within the residual of an eigenvalue, and (if
+    // not certified) low enough to be the negative one, not the null space
+    // of S that the rows of Y span.
+    const bool low_enough = out.certified || theta(0) <= -sigma_fail + residual;
+    if (low_enough && residual <= options.residual_tolerance * std::abs(theta(0)) + out.eta) {
+      break;
+    }
     // Not certified: move the shift towards the estimate (never past the
     // true minimum: then K is indefinite and the old shift is restored).
     if (!out.certified && theta(0) < 0.0 && out.iterations % 3 == 0) {
@@ -267,13 +278,26 @@ SeSyncCertificate SeSyncRelaxation::Certify(const Eigen::MatrixXd& Y, double F_e
         sigma = closer;
         out.lambda_lower = -sigma;
       } else if (closer < sigma) {
+        sigma_fail = std::max(sigma_fail, closer);
         (void)positive_definite_at(sigma);
       }
     }
   }
   out.lambda_min = theta(0);
   out.min_eigenvector = X.col(0).normalized();
-  out.dual_bound = out.relaxation_value + static_cast<double>(dn) * std::min(out.lambda_min, 0.0);
+  if (out.certified) {
+    // Lambda itself is dual feasible (to the tolerance eta): SE-Sync's bound.
+    out.dual_bound = out.relaxation_value;
+  } else {
+    // A proved bound: tighten lambda_lower to the estimate minus its
+    // residual with one more factorisation, then Lambda + lambda_lower I is
+    // dual feasible.
+    const double tighter = -(theta(0) - residual);
+    if (tighter > 0.0 && tighter < sigma && positive_definite_at(tighter)) {
+      out.lambda_lower = -tighter;
+    }
+    out.dual_bound = out.relaxation_value + static_cast<double>(dn) * out.lambda_lower;
+  }
   out.suboptimality_bound = F_estimate - out.dual_bound;
   out.time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return out;

@@ -65,8 +65,10 @@ struct SeSyncCertificate {
   double lambda_lower = 0.0;      ///< Proved lower bound: lambda_min(S) > lambda_lower.
   double eta = 0.0;               ///< The absolute tolerance used.
   double relaxation_value = 0.0;  ///< tr(Y Q Y^T) = tr(Lambda): F with optimal translations.
-  /// Lower bound on the global optimum F*: tr(Lambda) + dn min(lambda_min, 0)
-  /// (Lambda + min(lambda_min, 0) I is feasible for the relaxation's dual).
+  /// Lower bound on the global optimum F* from the relaxation's dual: certified,
+  /// tr(Lambda) (Lambda is dual feasible to the tolerance eta, as SE-Sync
+  /// reports it); otherwise tr(Lambda) + dn lambda_lower (Lambda +
+  /// lambda_lower I is dual feasible, proved by a factorisation).
   double dual_bound = 0.0;
   /// F(x) - dual_bound for the F of the estimate x that was certified.
   double suboptimality_bound = 0.0;

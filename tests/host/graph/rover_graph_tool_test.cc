@@ -37,6 +37,12 @@ TEST(RoverGraphToolTest, SolveWritesResultAndSummary) {
   EXPECT_NE(out.str().find("RESULT dataset=intel objective=sesync iterations="), std::string::npos)
       << out.str();
   EXPECT_NE(out.str().find("  iter 1  cost "), std::string::npos);  // Progress lines.
+  // intel's information matrices have x-theta entries: SE-Sync ignores them.
+  EXPECT_NE(out.str().find("  ignored: 2512 edges: off-diagonal blocks ignored\n"),
+            std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("  certificate: certified (lambda_min "), std::string::npos);
+  EXPECT_NE(out.str().find(" certified=yes lambda_min="), std::string::npos);
   const mapping::PoseGraph solved = mapping::ReadG2oFile(options.output);
   EXPECT_NEAR(mapping::SeSyncObjective(solved), 52.35, 0.03);
   std::filesystem::remove(options.output);
@@ -57,6 +63,34 @@ TEST(RoverGraphToolTest, MalformedInputExitsOneWithFileAndLine) {
             std::string::npos)
       << err.str();
   std::filesystem::remove(path);
+}
+
+TEST(RoverGraphToolTest, Chi2RefusesAnIndefiniteMatrixNamingEdgeAndLine) {
+  const auto path = TempPath("indefinite.g2o");
+  {
+    std::ofstream f(path);
+    f << "VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\nVERTEX_SE3:QUAT 1 1 0 0 0 0 0 1\n"
+         "EDGE_SE3:QUAT 0 1 1 0 0 0 0 0 1 1 0 0 2 0 0 1 0 0 2 0 1 0 0 2 1 0 0 1 0 1\n";
+  }
+  SolveCommandOptions options;
+  options.input = path.string();
+  options.output = TempPath("indefinite_out.g2o").string();
+  std::ostringstream out, err;
+  EXPECT_EQ(RunSolve(options, out, err), 1);
+  EXPECT_NE(err.str().find(path.string() +
+                           ":3: edge 0 -> 1: expected a positive-definite information matrix "
+                           "for the chi2 objective"),
+            std::string::npos)
+      << err.str();
+  options.solver.objective = mapping::Objective::kSeSync;
+  std::ostringstream out2, err2;
+  EXPECT_EQ(RunSolve(options, out2, err2), 0) << err2.str();
+  EXPECT_NE(out2.str().find("ignored: 1 edge: off-diagonal blocks ignored; 1 of them: info "
+                            "matrix indefinite as a whole (first on line 3)"),
+            std::string::npos)
+      << out2.str();
+  std::filesystem::remove(path);
+  std::filesystem::remove(options.output);
 }
 
 TEST(RoverGraphToolTest, InfoReportsCountsAndComponents) {

@@ -84,11 +84,64 @@ TEST(G2oIoTest, MissingVertexNamesFileAndLine) {
             "bad.g2o:3: edge 1 -> 7 references vertex 7, which no VERTEX line defines");
 }
 
-TEST(G2oIoTest, NonPositiveDefiniteInformationNamesFileAndLine) {
-  const std::string message =
+TEST(G2oIoTest, NonPositiveDefiniteBlockNamesFileAndLine) {
+  // Translation block [[1, 2], [2, 1]]: no objective can use it.
+  std::string message =
       ErrorOf("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1 0 0 1 2 0 1 0 1\n");
-  EXPECT_EQ(message.rfind("bad.g2o:3: expected a positive-definite information matrix", 0), 0u)
+  EXPECT_EQ(message,
+            "bad.g2o:3: expected a positive-definite translation block (x, y) of the information "
+            "matrix, found one with smallest eigenvalue -1");
+  message = ErrorOf(
+      "VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\nVERTEX_SE3:QUAT 1 0 0 0 0 0 0 1\n"
+      "EDGE_SE3:QUAT 0 1 1 0 0 0 0 0 1 1 0 0 0 0 0 1 0 0 0 0 1 0 0 0 0 0 0 1 0 1\n");
+  EXPECT_EQ(message.rfind("bad.g2o:3: expected a positive-definite rotation block (qx, qy, qz)", 0),
+            0u)
       << message;
+}
+
+// Diagonal blocks I3, off-diagonal block 2 I3: eigenvalues 3 and -1.
+constexpr const char* kIndefinite3d =
+    "VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\nVERTEX_SE3:QUAT 1 1 0 0 0 0 0 1\n"
+    "EDGE_SE3:QUAT 0 1 1 0 0 0 0 0 1 1 0 0 2 0 0 1 0 0 2 0 1 0 0 2 1 0 0 1 0 1\n";
+
+TEST(G2oIoTest, IndefiniteAsAWholeIsReadAndRefusedByChi2) {
+  std::istringstream in(kIndefinite3d);
+  PoseGraph g = ReadG2o(in, "g.g2o");
+  ASSERT_EQ(g.edges.size(), 1u);
+  PoseGraph chi2 = g;
+  try {
+    SolvePoseGraph(chi2, PoseGraphSolverOptions{});
+    FAIL() << "no error";
+  } catch (const GraphError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(
+                  "g.g2o:3: edge 0 -> 1: expected a positive-definite information matrix for the "
+                  "chi2 objective, found smallest eigenvalue -1",
+                  0),
+              0u)
+        << e.what();
+  }
+}
+
+TEST(G2oIoTest, SeSyncObjectiveUsesTheBlocksAndSaysWhatItIgnored) {
+  std::istringstream in(kIndefinite3d);
+  PoseGraph g = ReadG2o(in, "g.g2o");
+  PoseGraphSolverOptions o;
+  o.objective = Objective::kSeSync;
+  const PoseGraphSolverSummary s = SolvePoseGraph(g, o);
+  EXPECT_EQ(s.information.off_diagonal_ignored, 1);
+  EXPECT_EQ(s.information.indefinite, 1);
+  EXPECT_EQ(s.information.Describe(),
+            "1 edge: off-diagonal blocks ignored; 1 of them: info matrix indefinite as a whole "
+            "(first on line 3)");
+  EXPECT_LT(s.F, 1e-12);  // One exact edge: F* = 0.
+  // A positive-definite matrix with an off-diagonal block is still noted.
+  std::istringstream pd(
+      "VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\nVERTEX_SE3:QUAT 1 1 0 0 0 0 0 1\n"
+      "EDGE_SE3:QUAT 0 1 1 0 0 0 0 0 1 1 0 0 0.5 0 0 1 0 0 0 0 1 0 0 0 1 0 0 1 0 1\n");
+  PoseGraph h = ReadG2o(pd, "h.g2o");
+  EXPECT_EQ(CheckInformation(h, Objective::kSeSync).Describe(),
+            "1 edge: off-diagonal blocks ignored");
+  EXPECT_EQ(CheckInformation(h, Objective::kChi2).Describe(), "");
 }
 
 TEST(G2oIoTest, NanInputNamesFileAndLine) {
