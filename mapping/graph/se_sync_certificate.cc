@@ -1,6 +1,5 @@
 #include "mapping/graph/se_sync_certificate.h"
 
-#include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
@@ -11,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "mapping/graph/cholmod_llt.h"
 #include "mapping/graph/graph_connectivity.h"
 #include "mapping/graph/se_sync_objective.h"
 
@@ -19,11 +19,9 @@ namespace rover::mapping {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-// CHOLMOD's supernodal LLT: reports failure (not positive definite) through
-// info(), which is the semidefiniteness test.
+// Reports failure (not positive definite) through info(): the test.
 struct SeSyncRelaxation::Factor {
-  Factor() { llt.cholmod().print = 0; }  // A failed test is an answer, not a warning.
-  Eigen::CholmodSupernodalLLT<SparseMatrix> llt;
+  CholmodLlt llt;
 };
 
 namespace {

@@ -2,7 +2,6 @@
 
 #include <ceres/cost_function.h>
 
-#include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <chrono>
@@ -13,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "mapping/graph/cholmod_llt.h"
 #include "mapping/graph/chordal_pose_2d_cost.h"
 #include "mapping/graph/chordal_pose_3d_cost.h"
 #include "mapping/graph/graph_connectivity.h"
@@ -331,8 +331,7 @@ SeSyncNewtonSummary SolveSeSyncNewton(PoseGraph& graph, const SeSyncNewtonOption
   out.initial_cost = cost;
   out.final_cost = cost;
   SparseMatrix A = problem.hessian();
-  Eigen::CholmodSupernodalLLT<SparseMatrix> llt;
-  llt.cholmod().print = 0;  // A failed factorisation only raises the damping.
+  CholmodLlt llt;  // Fails on an indefinite Hessian: that raises the damping.
   llt.analyzePattern(A);
   // Levenberg-Marquardt damping relative to diag(J^T J); 0: pure Newton.
   double mu = 0.0;
