@@ -71,6 +71,11 @@ int RunSolve(const SolveCommandOptions& options, std::ostream& out, std::ostream
         << Sci(c.suboptimality_bound) << ", dual bound " << Sci(c.dual_bound) << ", gradient norm "
         << Sci(c.gradient_norm) << ", " << c.factorisations << " factorisations, " << c.iterations
         << " eigen iterations, " << Fixed(c.time_s, 3) << " s\n";
+    if (s.staircase_rank > 0) {
+      out << "  Riemannian staircase: the rank-" << graph.dimension
+          << " critical point was not certified; climbed to rank " << s.staircase_rank << " ("
+          << s.staircase_iterations << " gradient steps), rounded and refined\n";
+    }
   }
   if (solver.outliers != mapping::OutlierHandling::kNone) {
     out << "  loop closures " << s.loop_closures << ", rejected " << s.rejected << '\n';

@@ -24,6 +24,7 @@
 #include "mapping/graph/relative_pose_3d_cost.h"
 #include "mapping/graph/se_sync_newton_solver.h"
 #include "mapping/graph/se_sync_objective.h"
+#include "mapping/graph/se_sync_staircase.h"
 
 namespace rover::mapping {
 namespace {
@@ -279,6 +280,7 @@ PoseGraphSolverOptions PoseGraphSolverOptions::Load(const ConfigNode& node) {
   o.gnc_step = node.GetInRange<double>("gnc_step", 1.01, 10.0, o.gnc_step);
   o.newton = node.GetEnum<bool>("sesync_solver", {{"newton", true}, {"ceres", false}}, o.newton);
   o.certify = node.GetEnum<bool>("certify", {{"true", true}, {"false", false}}, o.certify);
+  o.staircase = node.GetEnum<bool>("staircase", {{"true", true}, {"false", false}}, o.staircase);
   o.dogleg = node.GetEnum<bool>("trust_region", {{"lm", false}, {"dogleg", true}}, o.dogleg);
   o.initial_trust_region_radius = node.GetInRange<double>("initial_trust_region_radius", 1e-6, 1e16,
                                                           o.initial_trust_region_radius);
@@ -512,6 +514,24 @@ PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOpt
       options.outliers == OutlierHandling::kNone) {
     const SeSyncRelaxation relaxation(graph);
     out.certificate = relaxation.Certify(relaxation.Rotations(graph), out.F, options.certificate);
+    if (!out.certificate->certified && options.staircase) {
+      // A critical point that is not the global optimum: climb, round,
+      // refine at rank d and certify the result.
+      SeSyncStaircaseOptions staircase;
+      staircase.certificate = options.certificate;
+      const SeSyncStaircaseSummary climb = ClimbSeSyncStaircase(graph, *out.certificate, staircase);
+      out.staircase_rank = climb.rank;
+      out.staircase_iterations = climb.iterations;
+      SeSyncNewtonOptions newton;
+      newton.max_iterations = options.max_iterations;
+      newton.gauss_newton_steps = 0;  // Rounded from the relaxation: near the optimum.
+      const SeSyncNewtonSummary refined = SolveSeSyncNewton(graph, newton);
+      out.iterations += refined.iterations;
+      out.final_cost = refined.final_cost;
+      out.converged = refined.converged;
+      out.F = SeSyncObjective(graph);
+      out.certificate = relaxation.Certify(relaxation.Rotations(graph), out.F, options.certificate);
+    }
   }
   out.total_time_s = Seconds(start);
   out.chi2 = Chi2Objective(graph);

@@ -79,13 +79,16 @@ struct PoseGraphSolverOptions {
   /// optimality certificate of the solution (se_sync_certificate.h).
   bool certify = true;
   SeSyncCertificateOptions certificate;
+  /// If the certificate fails: climb SE-Sync's Riemannian staircase
+  /// (se_sync_staircase.h), round, refine with Newton and certify again.
+  bool staircase = true;
   /// Called once per Ceres iteration with (iteration, cost, seconds since the
   /// solve started); may be empty.
   std::function<void(int, double, double)> progress;
 
   /// Reads keys objective (chi2|sesync), initialisation (chordal|odometry|file),
   /// outliers (none|cauchy|gnc), trust_region (lm|dogleg),
-  /// sesync_solver (newton|ceres), certify (true|false),
+  /// sesync_solver (newton|ceres), certify (true|false), staircase (true|false),
   /// initial_trust_region_radius, cauchy_scale, gnc_threshold,
   /// outlier_confidence, gnc_step, sparse_library (auto|eigen),
   /// jacobi_scaling (true|false),
@@ -137,6 +140,11 @@ struct PoseGraphSolverSummary {
   /// SE-Sync's certificate of the solution (objective sesync, no outlier
   /// handling, `certify`); its time is part of total_time_s.
   std::optional<SeSyncCertificate> certificate;
+  /// Riemannian staircase (the rank-d certificate failed): highest rank
+  /// climbed (0: not needed) and its gradient steps; `certificate` is then
+  /// that of the refined rounded solution.
+  int staircase_rank = 0;
+  int staircase_iterations = 0;
 };
 
 /// Optimises the vertex poses of `graph` in place. The first vertex is held

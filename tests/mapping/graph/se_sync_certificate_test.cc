@@ -129,6 +129,7 @@ TEST(SeSyncCertificateTest, RefusesATwistedRingLocalMinimum) {
   PoseGraphSolverOptions o;
   o.objective = Objective::kSeSync;
   o.initialisation = Initialisation::kFile;
+  o.staircase = false;
   const PoseGraphSolverSummary local = SolvePoseGraph(twisted, o);
   EXPECT_TRUE(local.converged) << local.message;
   ASSERT_TRUE(local.certificate.has_value());
@@ -151,6 +152,29 @@ TEST(SeSyncCertificateTest, RefusesATwistedRingLocalMinimum) {
   EXPECT_GT(local.F, 1.0);
   EXPECT_LE(c.dual_bound, best.F + 1e-9);
   EXPECT_GE(c.suboptimality_bound, local.F - best.F - 1e-9);
+}
+
+TEST(SeSyncCertificateTest, StaircaseClimbsOutOfTheTwistedRing) {
+  // The same local minimum, with the staircase: the certificate fails at
+  // rank 2, the escape and descent one rank up (where the twist can unwind)
+  // and the rounding lead to the global minimum, certified at rank 2.
+  for (const int n : {8, 10, 16}) {
+    const PoseGraph truth = Ring(n, 100.0, 1.0);
+    PoseGraph twisted = truth;
+    for (int k = 1; k < n; ++k) {
+      const Eigen::Vector3d p = PlanarPose(truth.vertices[static_cast<size_t>(k)].pose);
+      twisted.vertices[static_cast<size_t>(k)].pose =
+          PoseFromPlanar(p.x(), p.y(), p.z() + 2.0 * M_PI * k / n);
+    }
+    PoseGraphSolverOptions o;
+    o.objective = Objective::kSeSync;
+    o.initialisation = Initialisation::kFile;
+    const PoseGraphSolverSummary s = SolvePoseGraph(twisted, o);
+    ASSERT_TRUE(s.certificate.has_value());
+    EXPECT_GE(s.staircase_rank, 3) << "n = " << n;
+    EXPECT_TRUE(s.certificate->certified) << "n = " << n << ", F " << s.F;
+    EXPECT_LT(s.F, 1e-9) << "n = " << n;
+  }
 }
 
 }  // namespace
