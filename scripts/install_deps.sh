@@ -40,6 +40,7 @@ DEBIAN_PACKAGES=(
   libgl1-mesa-dri            # Mesa's llvmpipe software rasteriser: renders without a GPU
   liboctomap-dev             # submap voxels and the global map (mapping/submap, mapping/compose): .bt/.ot
   libceres-dev               # pose-graph back end (mapping/graph, rover-graph): Manifold API, sparse Cholesky
+  libsuitesparse-dev         # CHOLMOD (mapping/graph): sparse LL^T of the SE-Sync Newton solver and the certificate's definiteness test
   rt-tests                   # cyclictest: reference wake-up latency for scripts/rt_latency.sh
   libsystemd-dev             # sd_notify: roverd's systemd watchdog and readiness notification
   libcpp-httplib-dev         # HTTP log service on the board and `rover-log list/download` (cpp-httplib 0.11)
