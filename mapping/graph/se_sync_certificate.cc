@@ -162,6 +162,11 @@ SeSyncCertificate SeSyncRelaxation::Certify(const Eigen::MatrixXd& Y, double F_e
     throw std::invalid_argument("SeSyncRelaxation::Certify: expected Y with " + std::to_string(dn) +
                                 " columns, found " + std::to_string(Y.cols()));
   }
+  if (n_ <= 1) {  // Nothing relative to certify: one pose is its own optimum.
+    out.certified = true;
+    out.min_eigenvector = Eigen::VectorXd::Zero(dn);
+    return out;
+  }
   const Eigen::MatrixXd QYt = QProduct(Y.transpose());
   const Eigen::MatrixXd lambda = LambdaBlocks(Y, QYt);
   for (int i = 0; i < n_; ++i) out.relaxation_value += lambda.middleCols(d_ * i, d_).trace();
