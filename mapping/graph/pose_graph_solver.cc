@@ -488,9 +488,10 @@ PoseGraphSolverSummary SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOpt
     out.initial_cost = s.initial_cost;
     out.final_cost = s.final_cost;
     out.converged = s.converged;
-    out.message = "Newton (exact Hessian): " + std::to_string(s.iterations) + " iterations, " +
-                  std::to_string(s.factorisations) + " factorisations, " + s.message +
-                  ", gradient max-norm " + std::to_string(s.gradient_max_norm);
+    std::ostringstream message;
+    message << "Newton (exact Hessian): " << s.iterations << " iterations, " << s.factorisations
+            << " factorisations, " << s.message << ", gradient max-norm " << s.gradient_max_norm;
+    out.message = message.str();
   } else {
     Problem problem(graph, options);
     run(problem, options.max_iterations);
