@@ -319,6 +319,50 @@ TEST(RoverGraphTest, OriginMarginalsExistAndShrinkAfterLoopClosure) {
   EXPECT_LT(g.OriginCovariance(0, 7).trace(), before[7].trace());
 }
 
+// Adding origins one frame switch at a time (with a loop closure now and
+// then) gives the same estimates and origin marginals as solving everything
+// at every step, while the updates that only extend the chain solve nothing.
+TEST(RoverGraphTest, IncrementalUpdatesMatchFullSolves) {
+  std::mt19937 rng(5);
+  RobotSequence s(rng, {0, 0, 0}, 10.0, 120, 0.0);
+  RoverGraphOptions full_options;
+  full_options.incremental = false;
+  RoverGraph incremental;
+  RoverGraph full(full_options);
+  for (RoverGraph* g : {&incremental, &full}) {
+    g->AddOriginPrior(0, s.origins[0], Diagonal(1e-8, 1e-8, 1e-8));
+  }
+  int solves = 0;
+  for (size_t i = 0; i < s.w.size(); ++i) {
+    const auto submap = static_cast<int64_t>(i);
+    const bool loop = i == 6 || i == 9;
+    const Eigen::Isometry3d match =
+        Noisy(rng, s.origins[i + 1].inverse() * s.origins[i - 6 * loop], 0.05, 0.005);
+    for (RoverGraph* g : {&incremental, &full}) {
+      g->AddFrameSwitch(0, submap, s.w[i], s.w_cov[i]);
+      g->AddFilterPose(0, submap + 1, static_cast<int64_t>(i), s.v[i], s.v_cov[i]);
+      if (loop) {
+        g->AddSubmapMatch(0, submap + 1, 0, submap + 1 - 7, match,
+                          Diagonal(0.0025, 2.5e-5, 2.5e-5));
+      }
+    }
+    const RoverGraphSummary summary = incremental.Optimize();
+    full.Optimize();
+    solves += summary.solved ? 1 : 0;
+    EXPECT_EQ(summary.solved, i == 0 || loop) << "update " << i;
+    for (int64_t k = 0; k <= submap + 1; ++k) {
+      const Eigen::Isometry3d a = incremental.Origin(0, k);
+      const Eigen::Isometry3d b = full.Origin(0, k);
+      EXPECT_LT((a.matrix() - b.matrix()).cwiseAbs().maxCoeff(), 1e-6) << "s0_" << k;
+      const Matrix6d ca = incremental.OriginCovariance(0, k);
+      const Matrix6d cb = full.OriginCovariance(0, k);
+      EXPECT_LT((ca - cb).cwiseAbs().maxCoeff(), 1e-6 * cb.cwiseAbs().maxCoeff() + 1e-12)
+          << "s0_" << k << " after update " << i;
+    }
+  }
+  EXPECT_EQ(solves, 3);
+}
+
 TEST(RoverGraphTest, GlobalPoseIsOriginComposedWithFilterPose) {
   Scenario sc;
   RoverGraph g;
