@@ -1,0 +1,46 @@
+#ifndef ROVER_MAPPING_SLAM_GRAPH_LOG_H_
+#define ROVER_MAPPING_SLAM_GRAPH_LOG_H_
+
+// The pose graph in mapd's MCAP log: every factor as it was added
+// (rover_msgs/GraphFactor), the optimised origins after each update
+// (rover_msgs/SubmapOrigins) and the global pose s_j (+) v_t
+// (geometry_msgs/PoseWithCovarianceStamped). Reading it back rebuilds the
+// graph: a restarted mapd carries on from it, `rover-graph` re-optimises it.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/log/msgs/geometry_msgs.h"
+#include "core/log/msgs/rover_msgs.h"
+#include "mapping/slam/graph_factor_record.h"
+
+namespace rover::mapping {
+
+inline constexpr std::string_view kGraphFactorTopic = "/mapd/graph/factors";
+inline constexpr std::string_view kSubmapOriginsTopic = "/mapd/graph/origins";
+inline constexpr std::string_view kGlobalPoseTopic = "/mapd/global_pose";
+
+/// What one or more mapd logs hold of the graph.
+struct GraphLogContents {
+  /// Every readable factor once (by robot and id), in log order.
+  std::vector<GraphFactorRecord> factors;
+  /// The last origins and global pose logged (the run's final estimate).
+  std::optional<log::rover_msgs::SubmapOrigins> last_origins;
+  std::optional<log::geometry_msgs::PoseWithCovarianceStamped> last_global_pose;
+  /// Factors left out and damage, each naming the file and the factor.
+  std::vector<std::string> problems;
+  uint64_t duplicates = 0;  ///< Factors read again (a later log repeats an earlier one's).
+  bool truncated = false;   ///< Some file ends early (e.g. mapd was killed).
+};
+
+/// Reads the graph from `paths` in order (a mission's mapd logs, oldest
+/// first). A malformed factor or a damaged chunk is reported in `problems`
+/// and left out; the rest is kept. Throws log::McapError if a file cannot be
+/// opened at all.
+GraphLogContents ReadGraphLogs(const std::vector<std::string>& paths);
+
+}  // namespace rover::mapping
+
+#endif  // ROVER_MAPPING_SLAM_GRAPH_LOG_H_
