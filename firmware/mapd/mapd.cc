@@ -11,7 +11,10 @@
 #include <opencv2/core.hpp>
 
 #include "core/log/msgs/message_traits.h"
+#include "core/stats/percentile.h"
 #include "firmware/mapd/submap_archive.h"
+#include "mapping/slam/graph_factor_record.h"
+#include "mapping/slam/graph_log.h"
 
 namespace rover::mapd {
 namespace {
@@ -131,6 +134,7 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
     archive_ = std::make_unique<SubmapArchive>(options_.output_stem, options_.robot_name,
                                                mapping::MapComposerOptions{});
   }
+  if (options_.slam) slam_ = std::make_unique<SlamWorker>(options_.graph, options_.robot_id);
   trigger_.RequestAtNextPose();
 }
 
@@ -163,6 +167,7 @@ int Mapd::Poll() {
     ++handled;
   }
   TryMapPending();
+  if (slam_) TakeSlamSnapshot();
   if (poses_->HasMissedData()) ++stats_.missed;
   if (frames_->HasMissedData()) ++stats_.missed;
   const Time now = Time::Now();
@@ -176,6 +181,23 @@ void Mapd::OnFrameSwitch(const topics::FrameSwitchMsg& record) {
     return;
   }
   ++stats_.frame_switches;
+  if (slam_) {
+    EnsurePrior(record.old_frame_id, record.stamp_ns);
+    Eigen::Matrix4d covariance;
+    for (int i = 0; i < 16; ++i)
+      covariance(i / 4, i % 4) = record.covariance[static_cast<std::size_t>(i)];
+    mapping::GraphFactorRecord w = mapping::FrameSwitchFactor(
+        options_.robot_id, record.old_frame_id,
+        Eigen::Vector3d(record.p_old_new_m[0], record.p_old_new_m[1], record.p_old_new_m[2]),
+        record.yaw_old_new_rad, covariance);
+    w.stamp_ns = record.stamp_ns;
+    if (record.new_frame_id == record.old_frame_id + 1) {
+      AddFactor(std::move(w));
+    } else {
+      std::fprintf(stderr, "mapd: frame switch %u -> %u skips frames: left out of the graph\n",
+                   record.old_frame_id, record.new_frame_id);
+    }
+  }
   // Topics are not ordered against each other: the new frame's first
   // estimates may have arrived (and opened its submap) before this record.
   if (!submaps_.empty() && submaps_.back().frame_id == record.new_frame_id &&
@@ -226,6 +248,11 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
   // would refuse a switch.
   if ((pose.status & topics::kPoseStatusNotInitialised) != 0) return;
   const Time stamp = Time::FromNanoseconds(pose.stamp_ns);
+  if (slam_) {
+    EnsurePrior(pose.frame_id, pose.stamp_ns);
+    latest_pose_ = pose;
+    if (Time::Now() - last_global_pose_handed_ >= options_.global_pose_period) HandLatestPose();
+  }
   const Eigen::Vector3d p(pose.p_local_body_m[0], pose.p_local_body_m[1], pose.p_local_body_m[2]);
   const std::optional<topics::SwitchReason> reason =
       trigger_.OnPose(stamp, pose.frame_id, p, pose.position_sigma_m);
@@ -397,6 +424,81 @@ void Mapd::FinishMappingSubmap() {
   mapping_submap_.reset();
 }
 
+void Mapd::HandLatestPose() {
+  if (!latest_pose_) return;
+  last_global_pose_handed_ = Time::Now();
+  const topics::PoseMsg& pose = *latest_pose_;
+  mapping::Matrix6d covariance;
+  for (int i = 0; i < 36; ++i) {
+    covariance(i / 6, i % 6) = pose.pose_covariance[static_cast<std::size_t>(i)];
+  }
+  slam_->SetFilterPose(pose.stamp_ns, pose.frame_id, PoseOf(pose).T_local_body, covariance);
+  latest_pose_.reset();
+}
+
+void Mapd::EnsurePrior(uint32_t frame_id, int64_t stamp_ns) {
+  if (prior_added_) return;
+  prior_added_ = true;
+  // The rover's world frame is the first local frame the graph sees; a tight
+  // prior fixes the gauge without pulling on anything else.
+  mapping::GraphFactorRecord prior =
+      mapping::OriginPriorFactor(options_.robot_id, frame_id, Eigen::Isometry3d::Identity(),
+                                 1e-12 * mapping::Matrix6d::Identity());
+  prior.stamp_ns = stamp_ns;
+  AddFactor(std::move(prior));
+}
+
+void Mapd::AddFactor(mapping::GraphFactorRecord factor) {
+  factor.id = next_factor_id_++;
+  const log::rover_msgs::GraphFactor msg = mapping::ToMsg(factor, "graph/" + options_.robot_name);
+  if (archive_) archive_->LogFactor(msg);  // kept even if refused: the log is the record
+  // The graph gets exactly what the log holds, so it can be rebuilt from it.
+  try {
+    slam_->Submit(mapping::FromMsg(msg));
+  } catch (const mapping::GraphError& e) {
+    ++stats_.graph_factors_refused;
+    std::fprintf(stderr, "mapd: pose graph: factor left out: %s\n", e.what());
+  }
+}
+
+void Mapd::TakeSlamSnapshot() {
+  for (const std::string& problem : slam_->TakeProblems()) {
+    std::fprintf(stderr, "mapd: pose graph: %s\n", problem.c_str());
+  }
+  const SlamSnapshot snap = slam_->Latest();
+  if (snap.update == last_snapshot_update_) return;
+  last_snapshot_update_ = snap.update;
+  if (!archive_) return;
+  std::map<int64_t, Eigen::Isometry3d> T_world_frame;
+  log::rover_msgs::SubmapOrigins origins;
+  origins.header.stamp = log::ToRosTime(Time::FromNanoseconds(snap.stamp_ns));
+  origins.header.frame_id = log::FrameId::Truncated("world");
+  origins.update = snap.update;
+  for (const auto& [frame, o] : snap.origins) {
+    T_world_frame[frame] = o.T_world_origin;
+    log::rover_msgs::SubmapOrigin m;
+    m.robot = options_.robot_id;
+    m.submap = frame;
+    m.pose = mapping::ToPoseMsg(o.T_world_origin);
+    for (int i = 0; i < 36; ++i)
+      m.covariance[static_cast<std::size_t>(i)] = o.covariance(i / 6, i % 6);
+    origins.origins.push_back(m);
+  }
+  archive_->SetOrigins(T_world_frame);
+  std::optional<log::geometry_msgs::PoseWithCovarianceStamped> pose;
+  if (snap.T_world_body) {
+    pose.emplace();
+    pose->header.stamp = log::ToRosTime(Time::FromNanoseconds(snap.global_pose_stamp_ns));
+    pose->header.frame_id = log::FrameId::Truncated("world");
+    pose->pose.pose = mapping::ToPoseMsg(*snap.T_world_body);
+    const mapping::Matrix6d ros =
+        mapping::RosPoseCovariance(snap.T_world_body->linear(), snap.global_pose_covariance);
+    for (int i = 0; i < 36; ++i)
+      pose->pose.covariance[static_cast<std::size_t>(i)] = ros(i / 6, i % 6);
+  }
+  archive_->LogGraphState(origins, pose);
+}
+
 MapdBandwidth Mapd::Bandwidth() const {
   MapdBandwidth b;
   const double span_s =
@@ -413,17 +515,37 @@ MapdBandwidth Mapd::Bandwidth() const {
 void Mapd::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  if (slam_) {
+    HandLatestPose();  // the run's final global pose is the last estimate's
+    slam_->Flush();
+    TakeSlamSnapshot();
+  }
   if (!archive_) return;
   FinishMappingSubmap();
   const MapdBandwidth b = Bandwidth();
-  archive_->Close({{"submaps", std::to_string(stats_.submaps_archived)},
-                   {"images_mapped", std::to_string(stats_.images_mapped)},
-                   {"images_skipped", std::to_string(stats_.images_skipped)},
-                   {"images_unplaced", std::to_string(stats_.images_unplaced)},
-                   {"octree_bytes", std::to_string(stats_.octree_bytes)},
-                   {"cloud_bytes", std::to_string(stats_.cloud_bytes)},
-                   {"raw_stereo_bytes_per_s", std::to_string(b.raw_stereo_bytes_per_s)},
-                   {"submap_bytes_per_s", std::to_string(b.submap_bytes_per_s)}});
+  std::map<std::string, std::string> graph;
+  if (slam_) {
+    const SlamStats g = slam_->Stats();
+    graph["graph_factors"] = std::to_string(g.factors_added);
+    graph["graph_factors_refused"] = std::to_string(g.factors_refused);
+    graph["graph_updates"] = std::to_string(g.updates);
+    graph["graph_solves"] = std::to_string(g.solves);
+    if (!g.update_ms.empty()) {
+      graph["graph_update_ms_p50"] = std::to_string(stats::Percentile(g.update_ms, 50.0));
+      graph["graph_update_ms_p99"] = std::to_string(stats::Percentile(g.update_ms, 99.0));
+    }
+  }
+  std::map<std::string, std::string> statistics = {
+      {"submaps", std::to_string(stats_.submaps_archived)},
+      {"images_mapped", std::to_string(stats_.images_mapped)},
+      {"images_skipped", std::to_string(stats_.images_skipped)},
+      {"images_unplaced", std::to_string(stats_.images_unplaced)},
+      {"octree_bytes", std::to_string(stats_.octree_bytes)},
+      {"cloud_bytes", std::to_string(stats_.cloud_bytes)},
+      {"raw_stereo_bytes_per_s", std::to_string(b.raw_stereo_bytes_per_s)},
+      {"submap_bytes_per_s", std::to_string(b.submap_bytes_per_s)}};
+  statistics.merge(graph);
+  archive_->Close(statistics);
 }
 
 std::string Mapd::log_path() const { return archive_ ? archive_->log_path() : std::string(); }
@@ -466,6 +588,21 @@ std::string Mapd::Summary() const {
                   b.raw_stereo_bytes_per_s > 0.0
                       ? 100.0 * b.submap_bytes_per_s / b.raw_stereo_bytes_per_s
                       : 0.0);
+    out += text;
+  }
+  if (slam_) {
+    const SlamStats g = slam_->Stats();
+    const double p50 = g.update_ms.empty() ? 0.0 : stats::Percentile(g.update_ms, 50.0);
+    const double p99 = g.update_ms.empty() ? 0.0 : stats::Percentile(g.update_ms, 99.0);
+    char text[240];
+    std::snprintf(text, sizeof(text),
+                  "  graph: %llu factors (%llu refused), %llu updates (%llu solves, %llu failed), "
+                  "update %.2f ms p50, %.2f ms p99\n",
+                  static_cast<unsigned long long>(g.factors_added),
+                  static_cast<unsigned long long>(g.factors_refused),
+                  static_cast<unsigned long long>(g.updates),
+                  static_cast<unsigned long long>(g.solves),
+                  static_cast<unsigned long long>(g.update_errors), p50, p99);
     out += text;
   }
   char line[200];

@@ -148,17 +148,15 @@ class RoverGraph::Impl {
         queue.push_back(forward ? *f.b : f.a);
       }
     }
-    std::vector<std::string> loose;
+    unanchored_.clear();
     for (const auto& [key, v] : variables_) {
-      if (!v.initialized) loose.push_back(key.ToString());
+      if (!v.initialized) unanchored_.push_back(key);
     }
-    if (!loose.empty()) {
-      std::string names;
-      for (size_t k = 0; k < loose.size() && k < 10; ++k) names += (k ? ", " : "") + loose[k];
-      if (loose.size() > 10) names += ", ...";
-      throw GraphError("gauge problem: " + std::to_string(loose.size()) +
-                       " variable(s) not connected to any prior (unanchored component): " + names);
-    }
+  }
+
+  // A factor can enter the problem once both its variables are anchored.
+  bool Ready(const Factor& f) const {
+    return variables_.at(f.a).initialized && (!f.b || variables_.at(*f.b).initialized);
   }
 
   // True when the factors not yet in the problem only hang new variables
@@ -177,7 +175,7 @@ class RoverGraph::Impl {
       return k;
     };
     for (const Factor& f : factors_) {
-      if (f.in_problem) continue;
+      if (f.in_problem || !Ready(f)) continue;
       const GraphKey ra = root(f.a);
       const GraphKey rb = f.b ? root(*f.b) : anchored;
       if (ra == rb) return false;  // closes a loop (or joins two old variables)
@@ -203,7 +201,7 @@ class RoverGraph::Impl {
     bool progress = true;
     std::vector<const Factor*> pending;
     for (const Factor& f : factors_) {
-      if (!f.in_problem) pending.push_back(&f);
+      if (!f.in_problem && Ready(f)) pending.push_back(&f);
     }
     while (progress) {
       progress = false;
@@ -240,12 +238,12 @@ class RoverGraph::Impl {
 
   void AddPendingToProblem() {
     for (auto& [key, v] : variables_) {
-      if (v.in_problem) continue;
+      if (v.in_problem || !v.initialized) continue;
       problem_->AddParameterBlock(v.x.data(), 7, &manifold_);
       v.in_problem = true;
     }
     for (Factor& f : factors_) {
-      if (f.in_problem) continue;
+      if (f.in_problem || !Ready(f)) continue;
       ceres::LossFunction* loss = f.robust ? &cauchy_ : nullptr;
       double* a = variables_.at(f.a).x.data();
       if (f.b) {
@@ -261,6 +259,7 @@ class RoverGraph::Impl {
   RoverGraphSummary Optimize() {
     RoverGraphSummary out;
     Initialise();
+    out.unanchored = unanchored_;
     const Clock::time_point start = Clock::now();
     if (options_.incremental && solved_once_ && PendingFactorsExtendTheGraph()) {
       // Exact without a solve (see above); only the new covariances are due.
@@ -321,13 +320,15 @@ class RoverGraph::Impl {
     ceres::Covariance covariance(co);
     std::vector<std::pair<const double*, const double*>> blocks;
     for (const auto& [key, v] : variables_) {
-      if (key.type == GraphKey::Type::kOrigin) blocks.emplace_back(v.x.data(), v.x.data());
+      if (key.type == GraphKey::Type::kOrigin && v.in_problem) {
+        blocks.emplace_back(v.x.data(), v.x.data());
+      }
     }
     if (!covariance.Compute(blocks, problem_.get())) {
       throw GraphError("origin covariances: the problem is rank deficient (gauge problem?)");
     }
     for (const auto& [key, v] : variables_) {
-      if (key.type != GraphKey::Type::kOrigin) continue;
+      if (key.type != GraphKey::Type::kOrigin || !v.in_problem) continue;
       Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
       covariance.GetCovarianceBlockInTangentSpace(v.x.data(), v.x.data(), C.data());
       origin_covariance_[key] = C;
@@ -340,6 +341,7 @@ class RoverGraph::Impl {
   std::map<GraphKey, Variable> variables_;
   std::vector<Factor> factors_;
   std::map<GraphKey, Matrix6d> origin_covariance_;
+  std::vector<GraphKey> unanchored_;
   bool solved_once_ = false;
   double last_cost_ = 0.0;
   struct FilterPose {

@@ -87,6 +87,10 @@ struct RoverGraphSummary {
   bool converged = false;
   /// False when the update only extended the graph (no solve was needed).
   bool solved = false;
+  /// Variables no prior reaches (e.g. a robot not yet linked to the team, or
+  /// a chain broken by a refused factor): left out of the solve, with their
+  /// factors, until a factor connects them.
+  std::vector<GraphKey> unanchored;
 };
 
 class RoverGraph {
@@ -140,9 +144,9 @@ class RoverGraph {
   /// Adds the factors received since the last call, initialises new
   /// variables, optimises (warm-started) and, if enabled, computes the origin
   /// marginals. With options.incremental, factors that only extend the graph
-  /// by new variables (no loop) are composed without a solve. Throws GraphError if there is no
-  /// prior, or if variables are not connected to any prior (gauge problem; the message names them),
-  /// or for NaN input.
+  /// by new variables (no loop) are composed without a solve. Variables that
+  /// no prior reaches wait outside the solve (summary.unanchored names them).
+  /// Throws GraphError if the graph has no prior at all.
   RoverGraphSummary Optimize();
 
   /// Current estimate of a variable (T_world_key). Throws GraphError if the

@@ -55,6 +55,31 @@ void ReadOne(const std::string& path, std::set<std::pair<int, uint64_t>>* seen,
 
 }  // namespace
 
+log::geometry_msgs::Pose ToPoseMsg(const Eigen::Isometry3d& T) {
+  log::geometry_msgs::Pose m;
+  const Eigen::Quaterniond q(T.linear());
+  m.position = {T.translation().x(), T.translation().y(), T.translation().z()};
+  m.orientation = {q.x(), q.y(), q.z(), q.w()};
+  return m;
+}
+
+Eigen::Isometry3d FromPoseMsg(const log::geometry_msgs::Pose& m) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() =
+      Eigen::Quaterniond(m.orientation.w, m.orientation.x, m.orientation.y, m.orientation.z)
+          .normalized()
+          .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(m.position.x, m.position.y, m.position.z);
+  return T;
+}
+
+Matrix6d RosPoseCovariance(const Eigen::Matrix3d& R_world_body, const Matrix6d& covariance) {
+  // R Exp(dphi) = Exp(R dphi) R: the world-axis rotation error is R dphi.
+  Matrix6d J = Matrix6d::Identity();
+  J.bottomRightCorner<3, 3>() = R_world_body;
+  return J * covariance * J.transpose();
+}
+
 GraphLogContents ReadGraphLogs(const std::vector<std::string>& paths) {
   GraphLogContents out;
   std::set<std::pair<int, uint64_t>> seen;

@@ -35,6 +35,14 @@ struct GraphLogContents {
   bool truncated = false;   ///< Some file ends early (e.g. mapd was killed).
 };
 
+/// geometry_msgs/Pose of T, and back.
+log::geometry_msgs::Pose ToPoseMsg(const Eigen::Isometry3d& T);
+Eigen::Isometry3d FromPoseMsg(const log::geometry_msgs::Pose& pose);
+
+/// A ROS PoseWithCovariance's covariance (rotation about the fixed X, Y, Z
+/// axes) from one over [dt (world); dphi (right, body axes)] at rotation R.
+Matrix6d RosPoseCovariance(const Eigen::Matrix3d& R_world_body, const Matrix6d& covariance);
+
 /// Reads the graph from `paths` in order (a mission's mapd logs, oldest
 /// first). A malformed factor or a damaged chunk is reported in `problems`
 /// and left out; the rest is kept. Throws log::McapError if a file cannot be
