@@ -2,9 +2,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -30,9 +32,10 @@ ipc::Topic TopicOf(std::string_view name) {
 
 template <typename T>
 std::unique_ptr<ipc::Subscriber<T>> Subscribe(ipc::Transport* transport, std::string_view name,
-                                              uint64_t queue) {
+                                              uint64_t queue, uint64_t history = 0) {
   std::string error;
-  auto s = transport->MakeSubscriber<T>(TopicOf(name), {.queue_capacity = queue}, &error);
+  auto s = transport->MakeSubscriber<T>(
+      TopicOf(name), {.queue_capacity = queue, .history_request = history}, &error);
   if (s == nullptr) {
     throw std::runtime_error("mapd: cannot subscribe to " + std::string(name) + ": " + error);
   }
@@ -87,6 +90,26 @@ StampedPose PoseOf(const topics::PoseMsg& m) {
   return p;
 }
 
+// The newest earlier mapd log beside `own_stem`.mcap: a restarted mapd's
+// predecessor. Names sort by start time ("mapd-<UTC time>-<pid>").
+std::optional<std::string> PreviousMapdLog(const std::string& own_stem) {
+  namespace fs = std::filesystem;
+  const fs::path own(own_stem + ".mcap");
+  std::optional<fs::path> best;
+  std::error_code error;
+  const fs::path folder = own.has_parent_path() ? own.parent_path() : fs::path(".");
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("mapd-", 0) != 0 || entry.path().extension() != ".mcap" ||
+        entry.path().filename() == own.filename()) {
+      continue;
+    }
+    if (!best || name > best->filename().string()) best = entry.path();
+  }
+  if (!best) return std::nullopt;
+  return best->string();
+}
+
 }  // namespace
 
 void MapdOptions::Validate() const {
@@ -111,7 +134,9 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
       poses_(Subscribe<topics::PoseMsg>(transport, topics::kPoseTopic, options.pose_queue)),
       // Two frames: a slow mapd works on the newest pair, never on a backlog.
       frames_(Subscribe<topics::StereoFrameMsg>(transport, topics::kStereoFrameTopic, 2)),
-      switches_(Subscribe<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic, 16)),
+      // The switches roverd kept: a restarted mapd needs the ones it missed.
+      switches_(Subscribe<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic,
+                                                  topics::kSwitchHistory, topics::kSwitchHistory)),
       requests_(
           Advertise<topics::FrameSwitchRequestMsg>(transport, topics::kFrameSwitchRequestTopic, 0)),
       // History 1: whoever connects later sees mapd's state at once.
@@ -134,7 +159,10 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
     archive_ = std::make_unique<SubmapArchive>(options_.output_stem, options_.robot_name,
                                                mapping::MapComposerOptions{});
   }
-  if (options_.slam) slam_ = std::make_unique<SlamWorker>(options_.graph, options_.robot_id);
+  if (options_.slam) {
+    slam_ = std::make_unique<SlamWorker>(options_.graph, options_.robot_id);
+    LoadResumeCandidate();
+  }
   trigger_.RequestAtNextPose();
 }
 
@@ -181,7 +209,9 @@ void Mapd::OnFrameSwitch(const topics::FrameSwitchMsg& record) {
     return;
   }
   ++stats_.frame_switches;
-  if (slam_) {
+  if (slam_) DecideResume(&record);
+  if (slam_ && switched_frames_.count(record.old_frame_id) == 0) {
+    switched_frames_.insert(record.old_frame_id);
     EnsurePrior(record.old_frame_id, record.stamp_ns);
     Eigen::Matrix4d covariance;
     for (int i = 0; i < 16; ++i)
@@ -249,6 +279,7 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
   if ((pose.status & topics::kPoseStatusNotInitialised) != 0) return;
   const Time stamp = Time::FromNanoseconds(pose.stamp_ns);
   if (slam_) {
+    DecideResume(nullptr);
     EnsurePrior(pose.frame_id, pose.stamp_ns);
     latest_pose_ = pose;
     if (Time::Now() - last_global_pose_handed_ >= options_.global_pose_period) HandLatestPose();
@@ -448,9 +479,62 @@ void Mapd::EnsurePrior(uint32_t frame_id, int64_t stamp_ns) {
   AddFactor(std::move(prior));
 }
 
+void Mapd::LoadResumeCandidate() {
+  if (options_.output_stem.empty()) return;
+  const std::optional<std::string> previous = PreviousMapdLog(options_.output_stem);
+  if (!previous) return;
+  try {
+    resume_candidate_ = mapping::ReadGraphLogs({*previous});
+    resume_path_ = *previous;
+    for (const std::string& p : resume_candidate_->problems) {
+      std::fprintf(stderr, "mapd: %s\n", p.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mapd: cannot read the previous log: %s\n", e.what());
+  }
+}
+
+void Mapd::DecideResume(const topics::FrameSwitchMsg* record) {
+  if (resume_decided_) return;
+  resume_decided_ = true;
+  if (!resume_candidate_) return;
+  // The same mission iff roverd's switch history holds a switch the earlier
+  // graph has: same frames, same stamp to the nanosecond.
+  bool same_mission = false;
+  for (const mapping::GraphFactorRecord& f : resume_candidate_->factors) {
+    same_mission =
+        same_mission || (record != nullptr && f.kind == mapping::FactorKind::kFrameSwitch &&
+                         f.a.index == record->old_frame_id && f.stamp_ns == record->stamp_ns);
+  }
+  if (!same_mission) {
+    std::fprintf(stderr, "mapd: %s is not this mission's (no switch in common): a new graph\n",
+                 resume_path_.c_str());
+    resume_candidate_.reset();
+    return;
+  }
+  std::fprintf(stderr, "mapd: resuming the pose graph of %s (%zu factors)\n", resume_path_.c_str(),
+               resume_candidate_->factors.size());
+  for (std::size_t k = 0; k < resume_candidate_->factors.size(); ++k) {
+    const mapping::GraphFactorRecord& f = resume_candidate_->factors[k];
+    if (f.kind == mapping::FactorKind::kPrior) prior_added_ = true;
+    if (f.kind == mapping::FactorKind::kFrameSwitch) switched_frames_.insert(f.a.index);
+    next_factor_id_ = std::max(next_factor_id_, f.id + 1);
+    LogAndSubmit(resume_candidate_->messages[k]);  // this log holds the whole graph again
+  }
+  stats_.graph_factors_resumed = resume_candidate_->factors.size();
+  resume_candidate_.reset();
+}
+
 void Mapd::AddFactor(mapping::GraphFactorRecord factor) {
   factor.id = next_factor_id_++;
-  const log::rover_msgs::GraphFactor msg = mapping::ToMsg(factor, "graph/" + options_.robot_name);
+  LogAndSubmit(factor);
+}
+
+void Mapd::LogAndSubmit(const mapping::GraphFactorRecord& factor) {
+  LogAndSubmit(mapping::ToMsg(factor, "graph/" + options_.robot_name));
+}
+
+void Mapd::LogAndSubmit(const log::rover_msgs::GraphFactor& msg) {
   if (archive_) archive_->LogFactor(msg);  // kept even if refused: the log is the record
   // The graph gets exactly what the log holds, so it can be rebuilt from it.
   try {

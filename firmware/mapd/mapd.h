@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@
 #include "firmware/mapd/slam_worker.h"
 #include "firmware/mapd/submap_trigger.h"
 #include "firmware/runtime/topics/rover_topics.h"
+#include "mapping/slam/graph_log.h"
 #include "mapping/submap/submap.h"
 #include "mapping/submap/submap_options.h"
 
@@ -113,6 +115,7 @@ struct MapdStats {
   uint64_t obstacle_points = 0;
   uint64_t grids_published = 0;
   uint64_t graph_factors_refused = 0;  ///< malformed before reaching the graph (NaN, ...)
+  uint64_t graph_factors_resumed = 0;  ///< taken over from the previous mapd's log
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
@@ -180,6 +183,14 @@ class Mapd {
   void LogTraversability(int64_t stamp_ns);
   /// Logs `factor` (with the next id) and hands its logged form to the graph.
   void AddFactor(mapping::GraphFactorRecord factor);
+  void LogAndSubmit(const mapping::GraphFactorRecord& factor);
+  void LogAndSubmit(const log::rover_msgs::GraphFactor& msg);
+  /// Reads the graph of the newest earlier mapd log beside ours.
+  void LoadResumeCandidate();
+  /// Once, at the first switch record or estimate: carries on with the
+  /// earlier log's graph if roverd's switch history shows it is this
+  /// mission's (a restart), or starts a new one.
+  void DecideResume(const runtime::topics::FrameSwitchMsg* record);
   /// Anchors the graph at `frame_id` (once): the world frame of this rover.
   void EnsurePrior(uint32_t frame_id, int64_t stamp_ns);
   /// Takes a new graph snapshot: moves the composed submaps, logs it.
@@ -213,6 +224,10 @@ class Mapd {
   uint64_t last_snapshot_update_ = 0;
   Time last_global_pose_handed_;
   std::optional<runtime::topics::PoseMsg> latest_pose_;  ///< not yet handed over
+  std::optional<mapping::GraphLogContents> resume_candidate_;
+  std::string resume_path_;
+  bool resume_decided_ = false;
+  std::set<int64_t> switched_frames_;  ///< frames whose switch (w) the graph has
   bool shut_down_ = false;
   std::vector<SubmapRecord> submaps_;
   std::optional<runtime::topics::FrameSwitchMsg> pending_origin_;

@@ -35,6 +35,7 @@ void ReadOne(const std::string& path, std::set<std::pair<int, uint64_t>>* seen,
           return true;
         }
         out->factors.push_back(std::move(record));
+        out->messages.push_back(std::move(msg));
       } catch (const GraphError& e) {
         out->problems.push_back(path + ": " + e.what() + " (left out)");
       }

@@ -26,6 +26,9 @@ inline constexpr std::string_view kGlobalPoseTopic = "/mapd/global_pose";
 struct GraphLogContents {
   /// Every readable factor once (by robot and id), in log order.
   std::vector<GraphFactorRecord> factors;
+  /// The logged message of each factor (same order): re-logging these, not a
+  /// re-encoding, keeps every number bit for bit.
+  std::vector<log::rover_msgs::GraphFactor> messages;
   /// The last origins and global pose logged (the run's final estimate).
   std::optional<log::rover_msgs::SubmapOrigins> last_origins;
   std::optional<log::geometry_msgs::PoseWithCovarianceStamped> last_global_pose;
