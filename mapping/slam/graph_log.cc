@@ -1,5 +1,7 @@
 #include "mapping/slam/graph_log.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <map>
 #include <set>
 #include <utility>
@@ -79,6 +81,31 @@ Matrix6d RosPoseCovariance(const Eigen::Matrix3d& R_world_body, const Matrix6d& 
   Matrix6d J = Matrix6d::Identity();
   J.bottomRightCorner<3, 3>() = R_world_body;
   return J * covariance * J.transpose();
+}
+
+std::optional<Eigen::Isometry3d> GraphInMap(const log::rover_msgs::SubmapOrigins& graph,
+                                            const std::map<uint32_t, Eigen::Isometry3d>& origins) {
+  if (graph.origins.empty()) return std::nullopt;
+  const auto anchor =
+      std::min_element(graph.origins.begin(), graph.origins.end(),
+                       [](const auto& a, const auto& b) { return a.submap < b.submap; });
+  if (anchor->submap < 0 || anchor->submap > UINT32_MAX) return std::nullopt;
+  const auto chained = origins.find(static_cast<uint32_t>(anchor->submap));
+  if (chained == origins.end()) return std::nullopt;
+  return Eigen::Isometry3d(chained->second * FromPoseMsg(anchor->pose).inverse());
+}
+
+std::size_t PlaceAtGraphOrigins(const log::rover_msgs::SubmapOrigins& graph,
+                                std::map<uint32_t, Eigen::Isometry3d>* origins) {
+  const std::optional<Eigen::Isometry3d> T_map_graph = GraphInMap(graph, *origins);
+  if (!T_map_graph) return 0;
+  std::size_t placed = 0;
+  for (const auto& o : graph.origins) {
+    if (o.submap < 0 || o.submap > UINT32_MAX) continue;
+    (*origins)[static_cast<uint32_t>(o.submap)] = *T_map_graph * FromPoseMsg(o.pose);
+    ++placed;
+  }
+  return placed;
 }
 
 GraphLogContents ReadGraphLogs(const std::vector<std::string>& paths) {

@@ -7,6 +7,7 @@
 // (geometry_msgs/PoseWithCovarianceStamped). Reading it back rebuilds the
 // graph: a restarted mapd carries on from it, `rover-graph` re-optimises it.
 
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -45,6 +46,19 @@ Eigen::Isometry3d FromPoseMsg(const log::geometry_msgs::Pose& pose);
 /// A ROS PoseWithCovariance's covariance (rotation about the fixed X, Y, Z
 /// axes) from one over [dt (world); dphi (right, body axes)] at rotation R.
 Matrix6d RosPoseCovariance(const Eigen::Matrix3d& R_world_body, const Matrix6d& covariance);
+
+/// Moves the frames of `origins` (T_map_frame by local frame id, e.g. chained
+/// from the switch records) to the pose graph's optimised origins. The graph
+/// is anchored at its lowest frame f0, which must be in `origins`:
+/// T_map_f = T_map_f0 * T_graph_f0^-1 * T_graph_f. Returns the number of
+/// frames placed by the graph (0 if f0 is not in `origins`).
+std::size_t PlaceAtGraphOrigins(const log::rover_msgs::SubmapOrigins& graph,
+                                std::map<uint32_t, Eigen::Isometry3d>* origins);
+
+/// T_map_graph: the graph's world frame in the map frame of `origins`, by
+/// the anchor frame f0 as above; nullopt if f0 is not in `origins`.
+std::optional<Eigen::Isometry3d> GraphInMap(const log::rover_msgs::SubmapOrigins& graph,
+                                            const std::map<uint32_t, Eigen::Isometry3d>& origins);
 
 /// Reads the graph from `paths` in order (a mission's mapd logs, oldest
 /// first). A malformed factor or a damaged chunk is reported in `problems`

@@ -102,11 +102,9 @@ std::string Num(double v, int digits) {
   return text;
 }
 
-// The submaps at the pose graph's optimised origins, and the graph's final
-// global pose against the truth. Each mapd log holds its own graph, anchored
-// at the first frame it saw (f0, identity); its frames are placed in the world
-// through the switch chain's f0: T_world_f = T_world_chain(f0) T_graph(f0)^-1
-// T_graph(f). Later logs (a restarted mapd) win for the frames they hold.
+// The submaps at the pose graph's optimised origins (mapping::
+// PlaceAtGraphOrigins), and the graph's final global pose against the truth.
+// A restarted mapd's log holds the whole graph again; later logs win.
 void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
                          const sim::RoverTrajectory& trajectory, const MissionFacts& mission,
                          std::map<uint32_t, Eigen::Isometry3d>* origins, MapResult* r,
@@ -117,23 +115,15 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     for (const mapping::GraphFactorRecord& f : g.factors) {
       if (f.kind == mapping::FactorKind::kSubmapMatch) ++r->loop_closures;
     }
-    if (!g.last_origins || g.last_origins->origins.empty()) continue;
-    const auto& graph = g.last_origins->origins;
-    const auto anchor =
-        std::min_element(graph.begin(), graph.end(),
-                         [](const auto& a, const auto& b) { return a.submap < b.submap; });
-    const auto chained = origins->find(static_cast<uint32_t>(anchor->submap));
-    if (chained == origins->end()) continue;
-    const Eigen::Isometry3d T_world_graph =
-        chained->second * mapping::FromPoseMsg(anchor->pose).inverse();
-    for (const auto& o : graph) {
-      (*origins)[static_cast<uint32_t>(o.submap)] = T_world_graph * mapping::FromPoseMsg(o.pose);
-      ++r->graph_origins;
-    }
+    if (!g.last_origins) continue;
+    const std::optional<Eigen::Isometry3d> T_world_graph =
+        mapping::GraphInMap(*g.last_origins, *origins);
+    if (!T_world_graph) continue;
+    r->graph_origins += mapping::PlaceAtGraphOrigins(*g.last_origins, origins);
     if (!g.last_global_pose) continue;
     const Time stamp = log::FromRosTime(g.last_global_pose->header.stamp);
     const Eigen::Vector3d p_est =
-        (T_world_graph * mapping::FromPoseMsg(g.last_global_pose->pose.pose)).translation();
+        (*T_world_graph * mapping::FromPoseMsg(g.last_global_pose->pose.pose)).translation();
     const double t_s = (stamp - mission.start).ToSeconds();
     const Eigen::Vector3d p_true = trajectory.Evaluate(t_s).p_world_body;
     double distance_m = 0.0;

@@ -208,5 +208,36 @@ TEST(GraphLogTest, ALogCutMidFactorKeepsEveryEarlierFactor) {
   EXPECT_NE(problems.front().find("cut.mcap"), std::string::npos) << problems.front();
 }
 
+// The graph's origins replace the switch chain's, expressed in the chain's
+// map frame through the graph's anchor frame.
+TEST(GraphLogTest, GraphOriginsPlaceFramesInTheMapFrameThroughTheAnchor) {
+  std::mt19937 rng(8);
+  std::map<uint32_t, Eigen::Isometry3d> origins;  // the chain, map frame = frame 2
+  for (uint32_t f = 2; f <= 5; ++f) origins[f] = RandomPose(rng);
+  log::rover_msgs::SubmapOrigins graph;
+  std::map<int64_t, Eigen::Isometry3d> truth_in_graph;
+  for (int64_t f = 3; f <= 6; ++f) {  // anchored at frame 3
+    truth_in_graph[f] = RandomPose(rng);
+    log::rover_msgs::SubmapOrigin o;
+    o.submap = f;
+    o.pose = ToPoseMsg(truth_in_graph[f]);
+    graph.origins.push_back(o);
+  }
+  const Eigen::Isometry3d T_map_graph = origins.at(3) * truth_in_graph.at(3).inverse();
+  const std::map<uint32_t, Eigen::Isometry3d> chain = origins;
+  EXPECT_EQ(PlaceAtGraphOrigins(graph, &origins), 4u);
+  EXPECT_EQ(origins.at(2).matrix(), chain.at(2).matrix()) << "not in the graph: kept";
+  EXPECT_LT((origins.at(3).matrix() - chain.at(3).matrix()).norm(), 1e-12) << "the anchor stays";
+  for (int64_t f = 4; f <= 6; ++f) {
+    const Eigen::Isometry3d expected = T_map_graph * truth_in_graph.at(f);
+    EXPECT_LT((origins.at(static_cast<uint32_t>(f)).matrix() - expected.matrix()).norm(), 1e-9)
+        << f;
+  }
+  // A graph whose anchor the chain does not know places nothing.
+  std::map<uint32_t, Eigen::Isometry3d> elsewhere = {{9, Eigen::Isometry3d::Identity()}};
+  EXPECT_EQ(PlaceAtGraphOrigins(graph, &elsewhere), 0u);
+  EXPECT_FALSE(GraphInMap(graph, elsewhere).has_value());
+}
+
 }  // namespace
 }  // namespace rover::mapping
