@@ -2,16 +2,21 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
 #include <opencv2/core.hpp>
 
 #include "core/log/msgs/message_traits.h"
+#include "core/stats/percentile.h"
 #include "firmware/mapd/submap_archive.h"
+#include "mapping/slam/graph_factor_record.h"
+#include "mapping/slam/graph_log.h"
 
 namespace rover::mapd {
 namespace {
@@ -27,9 +32,10 @@ ipc::Topic TopicOf(std::string_view name) {
 
 template <typename T>
 std::unique_ptr<ipc::Subscriber<T>> Subscribe(ipc::Transport* transport, std::string_view name,
-                                              uint64_t queue) {
+                                              uint64_t queue, uint64_t history = 0) {
   std::string error;
-  auto s = transport->MakeSubscriber<T>(TopicOf(name), {.queue_capacity = queue}, &error);
+  auto s = transport->MakeSubscriber<T>(
+      TopicOf(name), {.queue_capacity = queue, .history_request = history}, &error);
   if (s == nullptr) {
     throw std::runtime_error("mapd: cannot subscribe to " + std::string(name) + ": " + error);
   }
@@ -84,6 +90,26 @@ StampedPose PoseOf(const topics::PoseMsg& m) {
   return p;
 }
 
+// The newest earlier mapd log beside `own_stem`.mcap: a restarted mapd's
+// predecessor. Names sort by start time ("mapd-<UTC time>-<pid>").
+std::optional<std::string> PreviousMapdLog(const std::string& own_stem) {
+  namespace fs = std::filesystem;
+  const fs::path own(own_stem + ".mcap");
+  std::optional<fs::path> best;
+  std::error_code error;
+  const fs::path folder = own.has_parent_path() ? own.parent_path() : fs::path(".");
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("mapd-", 0) != 0 || entry.path().extension() != ".mcap" ||
+        entry.path().filename() == own.filename()) {
+      continue;
+    }
+    if (!best || name > best->filename().string()) best = entry.path();
+  }
+  if (!best) return std::nullopt;
+  return best->string();
+}
+
 }  // namespace
 
 void MapdOptions::Validate() const {
@@ -108,7 +134,9 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
       poses_(Subscribe<topics::PoseMsg>(transport, topics::kPoseTopic, options.pose_queue)),
       // Two frames: a slow mapd works on the newest pair, never on a backlog.
       frames_(Subscribe<topics::StereoFrameMsg>(transport, topics::kStereoFrameTopic, 2)),
-      switches_(Subscribe<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic, 16)),
+      // The switches roverd kept: a restarted mapd needs the ones it missed.
+      switches_(Subscribe<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic,
+                                                  topics::kSwitchHistory, topics::kSwitchHistory)),
       requests_(
           Advertise<topics::FrameSwitchRequestMsg>(transport, topics::kFrameSwitchRequestTopic, 0)),
       // History 1: whoever connects later sees mapd's state at once.
@@ -130,6 +158,10 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
         Advertise<topics::TraversabilityMsg>(transport, topics::kTraversabilityTopic, 1);
     archive_ = std::make_unique<SubmapArchive>(options_.output_stem, options_.robot_name,
                                                mapping::MapComposerOptions{});
+  }
+  if (options_.slam) {
+    slam_ = std::make_unique<SlamWorker>(options_.graph, options_.robot_id);
+    LoadResumeCandidate();
   }
   trigger_.RequestAtNextPose();
 }
@@ -163,6 +195,7 @@ int Mapd::Poll() {
     ++handled;
   }
   TryMapPending();
+  if (slam_) TakeSlamSnapshot();
   if (poses_->HasMissedData()) ++stats_.missed;
   if (frames_->HasMissedData()) ++stats_.missed;
   const Time now = Time::Now();
@@ -176,6 +209,25 @@ void Mapd::OnFrameSwitch(const topics::FrameSwitchMsg& record) {
     return;
   }
   ++stats_.frame_switches;
+  if (slam_) DecideResume(&record);
+  if (slam_ && switched_frames_.count(record.old_frame_id) == 0) {
+    switched_frames_.insert(record.old_frame_id);
+    EnsurePrior(record.old_frame_id, record.stamp_ns);
+    Eigen::Matrix4d covariance;
+    for (int i = 0; i < 16; ++i)
+      covariance(i / 4, i % 4) = record.covariance[static_cast<std::size_t>(i)];
+    mapping::GraphFactorRecord w = mapping::FrameSwitchFactor(
+        options_.robot_id, record.old_frame_id,
+        Eigen::Vector3d(record.p_old_new_m[0], record.p_old_new_m[1], record.p_old_new_m[2]),
+        record.yaw_old_new_rad, covariance);
+    w.stamp_ns = record.stamp_ns;
+    if (record.new_frame_id == record.old_frame_id + 1) {
+      AddFactor(std::move(w));
+    } else {
+      std::fprintf(stderr, "mapd: frame switch %u -> %u skips frames: left out of the graph\n",
+                   record.old_frame_id, record.new_frame_id);
+    }
+  }
   // Topics are not ordered against each other: the new frame's first
   // estimates may have arrived (and opened its submap) before this record.
   if (!submaps_.empty() && submaps_.back().frame_id == record.new_frame_id &&
@@ -226,6 +278,12 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
   // would refuse a switch.
   if ((pose.status & topics::kPoseStatusNotInitialised) != 0) return;
   const Time stamp = Time::FromNanoseconds(pose.stamp_ns);
+  if (slam_) {
+    DecideResume(nullptr);
+    EnsurePrior(pose.frame_id, pose.stamp_ns);
+    latest_pose_ = pose;
+    if (Time::Now() - last_global_pose_handed_ >= options_.global_pose_period) HandLatestPose();
+  }
   const Eigen::Vector3d p(pose.p_local_body_m[0], pose.p_local_body_m[1], pose.p_local_body_m[2]);
   const std::optional<topics::SwitchReason> reason =
       trigger_.OnPose(stamp, pose.frame_id, p, pose.position_sigma_m);
@@ -397,6 +455,134 @@ void Mapd::FinishMappingSubmap() {
   mapping_submap_.reset();
 }
 
+void Mapd::HandLatestPose() {
+  if (!latest_pose_) return;
+  last_global_pose_handed_ = Time::Now();
+  const topics::PoseMsg& pose = *latest_pose_;
+  mapping::Matrix6d covariance;
+  for (int i = 0; i < 36; ++i) {
+    covariance(i / 6, i % 6) = pose.pose_covariance[static_cast<std::size_t>(i)];
+  }
+  slam_->SetFilterPose(pose.stamp_ns, pose.frame_id, PoseOf(pose).T_local_body, covariance);
+  latest_pose_.reset();
+}
+
+void Mapd::EnsurePrior(uint32_t frame_id, int64_t stamp_ns) {
+  if (prior_added_) return;
+  prior_added_ = true;
+  // The rover's world frame is the first local frame the graph sees; a tight
+  // prior fixes the gauge without pulling on anything else.
+  mapping::GraphFactorRecord prior =
+      mapping::OriginPriorFactor(options_.robot_id, frame_id, Eigen::Isometry3d::Identity(),
+                                 1e-12 * mapping::Matrix6d::Identity());
+  prior.stamp_ns = stamp_ns;
+  AddFactor(std::move(prior));
+}
+
+void Mapd::LoadResumeCandidate() {
+  if (options_.output_stem.empty()) return;
+  const std::optional<std::string> previous = PreviousMapdLog(options_.output_stem);
+  if (!previous) return;
+  try {
+    resume_candidate_ = mapping::ReadGraphLogs({*previous});
+    resume_path_ = *previous;
+    for (const std::string& p : resume_candidate_->problems) {
+      std::fprintf(stderr, "mapd: %s\n", p.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mapd: cannot read the previous log: %s\n", e.what());
+  }
+}
+
+void Mapd::DecideResume(const topics::FrameSwitchMsg* record) {
+  if (resume_decided_) return;
+  resume_decided_ = true;
+  if (!resume_candidate_) return;
+  // The same mission iff roverd's switch history holds a switch the earlier
+  // graph has: same frames, same stamp to the nanosecond.
+  bool same_mission = false;
+  for (const mapping::GraphFactorRecord& f : resume_candidate_->factors) {
+    same_mission =
+        same_mission || (record != nullptr && f.kind == mapping::FactorKind::kFrameSwitch &&
+                         f.a.index == record->old_frame_id && f.stamp_ns == record->stamp_ns);
+  }
+  if (!same_mission) {
+    std::fprintf(stderr, "mapd: %s is not this mission's (no switch in common): a new graph\n",
+                 resume_path_.c_str());
+    resume_candidate_.reset();
+    return;
+  }
+  std::fprintf(stderr, "mapd: resuming the pose graph of %s (%zu factors)\n", resume_path_.c_str(),
+               resume_candidate_->factors.size());
+  for (std::size_t k = 0; k < resume_candidate_->factors.size(); ++k) {
+    const mapping::GraphFactorRecord& f = resume_candidate_->factors[k];
+    if (f.kind == mapping::FactorKind::kPrior) prior_added_ = true;
+    if (f.kind == mapping::FactorKind::kFrameSwitch) switched_frames_.insert(f.a.index);
+    next_factor_id_ = std::max(next_factor_id_, f.id + 1);
+    LogAndSubmit(resume_candidate_->messages[k]);  // this log holds the whole graph again
+  }
+  stats_.graph_factors_resumed = resume_candidate_->factors.size();
+  resume_candidate_.reset();
+}
+
+void Mapd::AddFactor(mapping::GraphFactorRecord factor) {
+  factor.id = next_factor_id_++;
+  LogAndSubmit(factor);
+}
+
+void Mapd::LogAndSubmit(const mapping::GraphFactorRecord& factor) {
+  LogAndSubmit(mapping::ToMsg(factor, "graph/" + options_.robot_name));
+}
+
+void Mapd::LogAndSubmit(const log::rover_msgs::GraphFactor& msg) {
+  if (archive_) archive_->LogFactor(msg);  // kept even if refused: the log is the record
+  // The graph gets exactly what the log holds, so it can be rebuilt from it.
+  try {
+    slam_->Submit(mapping::FromMsg(msg));
+  } catch (const mapping::GraphError& e) {
+    ++stats_.graph_factors_refused;
+    std::fprintf(stderr, "mapd: pose graph: factor left out: %s\n", e.what());
+  }
+}
+
+void Mapd::TakeSlamSnapshot() {
+  for (const std::string& problem : slam_->TakeProblems()) {
+    std::fprintf(stderr, "mapd: pose graph: %s\n", problem.c_str());
+  }
+  const SlamSnapshot snap = slam_->Latest();
+  if (snap.update == last_snapshot_update_) return;
+  last_snapshot_update_ = snap.update;
+  if (!archive_) return;
+  std::map<int64_t, Eigen::Isometry3d> T_world_frame;
+  log::rover_msgs::SubmapOrigins origins;
+  origins.header.stamp = log::ToRosTime(Time::FromNanoseconds(snap.stamp_ns));
+  origins.header.frame_id = log::FrameId::Truncated("world");
+  origins.update = snap.update;
+  for (const auto& [frame, o] : snap.origins) {
+    T_world_frame[frame] = o.T_world_origin;
+    log::rover_msgs::SubmapOrigin m;
+    m.robot = options_.robot_id;
+    m.submap = frame;
+    m.pose = mapping::ToPoseMsg(o.T_world_origin);
+    for (int i = 0; i < 36; ++i)
+      m.covariance[static_cast<std::size_t>(i)] = o.covariance(i / 6, i % 6);
+    origins.origins.push_back(m);
+  }
+  archive_->SetOrigins(T_world_frame);
+  std::optional<log::geometry_msgs::PoseWithCovarianceStamped> pose;
+  if (snap.T_world_body) {
+    pose.emplace();
+    pose->header.stamp = log::ToRosTime(Time::FromNanoseconds(snap.global_pose_stamp_ns));
+    pose->header.frame_id = log::FrameId::Truncated("world");
+    pose->pose.pose = mapping::ToPoseMsg(*snap.T_world_body);
+    const mapping::Matrix6d ros =
+        mapping::RosPoseCovariance(snap.T_world_body->linear(), snap.global_pose_covariance);
+    for (int i = 0; i < 36; ++i)
+      pose->pose.covariance[static_cast<std::size_t>(i)] = ros(i / 6, i % 6);
+  }
+  archive_->LogGraphState(origins, pose);
+}
+
 MapdBandwidth Mapd::Bandwidth() const {
   MapdBandwidth b;
   const double span_s =
@@ -413,17 +599,37 @@ MapdBandwidth Mapd::Bandwidth() const {
 void Mapd::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  if (slam_) {
+    HandLatestPose();  // the run's final global pose is the last estimate's
+    slam_->Flush();
+    TakeSlamSnapshot();
+  }
   if (!archive_) return;
   FinishMappingSubmap();
   const MapdBandwidth b = Bandwidth();
-  archive_->Close({{"submaps", std::to_string(stats_.submaps_archived)},
-                   {"images_mapped", std::to_string(stats_.images_mapped)},
-                   {"images_skipped", std::to_string(stats_.images_skipped)},
-                   {"images_unplaced", std::to_string(stats_.images_unplaced)},
-                   {"octree_bytes", std::to_string(stats_.octree_bytes)},
-                   {"cloud_bytes", std::to_string(stats_.cloud_bytes)},
-                   {"raw_stereo_bytes_per_s", std::to_string(b.raw_stereo_bytes_per_s)},
-                   {"submap_bytes_per_s", std::to_string(b.submap_bytes_per_s)}});
+  std::map<std::string, std::string> graph;
+  if (slam_) {
+    const SlamStats g = slam_->Stats();
+    graph["graph_factors"] = std::to_string(g.factors_added);
+    graph["graph_factors_refused"] = std::to_string(g.factors_refused);
+    graph["graph_updates"] = std::to_string(g.updates);
+    graph["graph_solves"] = std::to_string(g.solves);
+    if (!g.update_ms.empty()) {
+      graph["graph_update_ms_p50"] = std::to_string(stats::Percentile(g.update_ms, 50.0));
+      graph["graph_update_ms_p99"] = std::to_string(stats::Percentile(g.update_ms, 99.0));
+    }
+  }
+  std::map<std::string, std::string> statistics = {
+      {"submaps", std::to_string(stats_.submaps_archived)},
+      {"images_mapped", std::to_string(stats_.images_mapped)},
+      {"images_skipped", std::to_string(stats_.images_skipped)},
+      {"images_unplaced", std::to_string(stats_.images_unplaced)},
+      {"octree_bytes", std::to_string(stats_.octree_bytes)},
+      {"cloud_bytes", std::to_string(stats_.cloud_bytes)},
+      {"raw_stereo_bytes_per_s", std::to_string(b.raw_stereo_bytes_per_s)},
+      {"submap_bytes_per_s", std::to_string(b.submap_bytes_per_s)}};
+  statistics.merge(graph);
+  archive_->Close(statistics);
 }
 
 std::string Mapd::log_path() const { return archive_ ? archive_->log_path() : std::string(); }
@@ -466,6 +672,21 @@ std::string Mapd::Summary() const {
                   b.raw_stereo_bytes_per_s > 0.0
                       ? 100.0 * b.submap_bytes_per_s / b.raw_stereo_bytes_per_s
                       : 0.0);
+    out += text;
+  }
+  if (slam_) {
+    const SlamStats g = slam_->Stats();
+    const double p50 = g.update_ms.empty() ? 0.0 : stats::Percentile(g.update_ms, 50.0);
+    const double p99 = g.update_ms.empty() ? 0.0 : stats::Percentile(g.update_ms, 99.0);
+    char text[240];
+    std::snprintf(text, sizeof(text),
+                  "  graph: %llu factors (%llu refused), %llu updates (%llu solves, %llu failed), "
+                  "update %.2f ms p50, %.2f ms p99\n",
+                  static_cast<unsigned long long>(g.factors_added),
+                  static_cast<unsigned long long>(g.factors_refused),
+                  static_cast<unsigned long long>(g.updates),
+                  static_cast<unsigned long long>(g.solves),
+                  static_cast<unsigned long long>(g.update_errors), p50, p99);
     out += text;
   }
   char line[200];

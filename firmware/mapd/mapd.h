@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -29,8 +30,10 @@
 #include "core/time/time.h"
 #include "firmware/mapd/local_mapper.h"
 #include "firmware/mapd/pose_history.h"
+#include "firmware/mapd/slam_worker.h"
 #include "firmware/mapd/submap_trigger.h"
 #include "firmware/runtime/topics/rover_topics.h"
+#include "mapping/slam/graph_log.h"
 #include "mapping/submap/submap.h"
 #include "mapping/submap/submap_options.h"
 
@@ -63,6 +66,15 @@ struct MapdOptions {
   std::string robot_name = "rover";
   /// Capture time between traversability grids in the log.
   Duration traversability_period = Duration::Seconds(1);
+
+  /// Run the pose graph (prior, frame switches; its own thread) and compose
+  /// the global map at its optimised origins.
+  bool slam = true;
+  mapping::RoverGraphOptions graph{};
+  /// This rover's id in the (team's) graph.
+  int robot_id = 0;
+  /// Wall time between global-pose updates handed to the graph thread.
+  Duration global_pose_period = Duration::Milliseconds(200);
 
   /// Throws std::invalid_argument naming the key.
   void Validate() const;
@@ -102,6 +114,8 @@ struct MapdStats {
   uint64_t cloud_bytes = 0;       ///< serialised sensor_msgs/PointCloud2 of finished submaps
   uint64_t obstacle_points = 0;
   uint64_t grids_published = 0;
+  uint64_t graph_factors_refused = 0;  ///< malformed before reaching the graph (NaN, ...)
+  uint64_t graph_factors_resumed = 0;  ///< taken over from the previous mapd's log
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
@@ -133,6 +147,10 @@ class Mapd {
 
   const std::vector<SubmapRecord>& submaps() const { return submaps_; }
   const MapdStats& stats() const { return stats_; }
+  /// The pose graph's counters (empty without slam).
+  SlamStats slam_stats() const { return slam_ ? slam_->Stats() : SlamStats{}; }
+  /// The latest graph snapshot (update 0 without slam).
+  SlamSnapshot slam_snapshot() const { return slam_ ? slam_->Latest() : SlamSnapshot{}; }
 
   /// Finishes the current submap, writes the run's statistics, the global
   /// map (map.bt, map.ot, map.ply) and closes the log. Idempotent; the
@@ -163,6 +181,22 @@ class Mapd {
   /// Archives the mapping submap (log, composition) and forgets it.
   void FinishMappingSubmap();
   void LogTraversability(int64_t stamp_ns);
+  /// Logs `factor` (with the next id) and hands its logged form to the graph.
+  void AddFactor(mapping::GraphFactorRecord factor);
+  void LogAndSubmit(const mapping::GraphFactorRecord& factor);
+  void LogAndSubmit(const log::rover_msgs::GraphFactor& msg);
+  /// Reads the graph of the newest earlier mapd log beside ours.
+  void LoadResumeCandidate();
+  /// Once, at the first switch record or estimate: carries on with the
+  /// earlier log's graph if roverd's switch history shows it is this
+  /// mission's (a restart), or starts a new one.
+  void DecideResume(const runtime::topics::FrameSwitchMsg* record);
+  /// Anchors the graph at `frame_id` (once): the world frame of this rover.
+  void EnsurePrior(uint32_t frame_id, int64_t stamp_ns);
+  /// Takes a new graph snapshot: moves the composed submaps, logs it.
+  void TakeSlamSnapshot();
+  /// Hands the newest estimate to the graph thread for the global pose.
+  void HandLatestPose();
 
   MapdOptions options_;
   SubmapTrigger trigger_;
@@ -184,6 +218,16 @@ class Mapd {
   std::unique_ptr<SubmapArchive> archive_;
   std::optional<Time> last_mapped_capture_;
   std::optional<Time> last_traversability_;
+  std::unique_ptr<SlamWorker> slam_;
+  bool prior_added_ = false;
+  uint64_t next_factor_id_ = 1;
+  uint64_t last_snapshot_update_ = 0;
+  Time last_global_pose_handed_;
+  std::optional<runtime::topics::PoseMsg> latest_pose_;  ///< not yet handed over
+  std::optional<mapping::GraphLogContents> resume_candidate_;
+  std::string resume_path_;
+  bool resume_decided_ = false;
+  std::set<int64_t> switched_frames_;  ///< frames whose switch (w) the graph has
   bool shut_down_ = false;
   std::vector<SubmapRecord> submaps_;
   std::optional<runtime::topics::FrameSwitchMsg> pending_origin_;

@@ -8,6 +8,7 @@
 #include "core/log/msgs/rover_msgs.h"
 #include "firmware/mapd/mapd.h"
 #include "mapping/compose/map_export.h"
+#include "mapping/slam/graph_log.h"
 #include "mapping/submap/submap_messages.h"
 
 namespace rover::mapd {
@@ -35,9 +36,11 @@ SubmapArchive::~SubmapArchive() = default;
 void SubmapArchive::OpenFrame(const SubmapRecord& record) {
   if (T_map_frame_.empty()) {
     T_map_frame_[record.frame_id] = Eigen::Isometry3d::Identity();
+    map_frame_ = record.frame_id;
     return;
   }
-  if (!record.origin) return;  // joined half-way: cannot be placed
+  if (T_map_frame_.count(record.frame_id) != 0) return;  // placed by the graph already
+  if (!record.origin) return;                            // joined half-way: cannot be placed
   const auto previous = T_map_frame_.find(record.origin->old_frame_id);
   if (previous == T_map_frame_.end()) return;
   T_map_frame_[record.frame_id] = previous->second * TransformOf(*record.origin);
@@ -91,7 +94,43 @@ ArchivedBytes SubmapArchive::Add(const SubmapRecord& record, const mapping::Subm
   }
   composer_.SetSubmap(record.index, std::make_shared<const octomap::OcTree>(submap.octree()), cloud,
                       placed->second);
+  composed_index_of_frame_[record.frame_id] = record.index;
   return bytes;
+}
+
+void SubmapArchive::LogFactor(const log::rover_msgs::GraphFactor& factor) {
+  if (!log_) return;
+  log_->Write(mapping::kGraphFactorTopic, log::FromRosTime(factor.header.stamp).nanoseconds(),
+              factor);
+  log_->Flush();
+}
+
+void SubmapArchive::LogGraphState(
+    const log::rover_msgs::SubmapOrigins& origins,
+    const std::optional<log::geometry_msgs::PoseWithCovarianceStamped>& pose) {
+  if (!log_) return;
+  log_->Write(mapping::kSubmapOriginsTopic, log::FromRosTime(origins.header.stamp).nanoseconds(),
+              origins);
+  if (pose) {
+    log_->Write(mapping::kGlobalPoseTopic, log::FromRosTime(pose->header.stamp).nanoseconds(),
+                *pose);
+  }
+}
+
+void SubmapArchive::SetOrigins(const std::map<int64_t, Eigen::Isometry3d>& T_world_frame) {
+  if (!map_frame_) return;
+  const auto map_origin = T_world_frame.find(*map_frame_);
+  if (map_origin == T_world_frame.end()) return;  // the graph does not reach the map frame
+  const Eigen::Isometry3d T_map_world = map_origin->second.inverse();
+  for (const auto& [frame, T] : T_world_frame) {
+    if (frame < 0 || frame > UINT32_MAX) continue;
+    const auto id = static_cast<uint32_t>(frame);
+    T_map_frame_[id] = T_map_world * T;
+    const auto composed = composed_index_of_frame_.find(id);
+    if (composed != composed_index_of_frame_.end()) {
+      composer_.SetOrigin(composed->second, T_map_frame_[id]);
+    }
+  }
 }
 
 void SubmapArchive::LogTraversability(const log::nav_msgs::OccupancyGrid& grid) {

@@ -16,7 +16,9 @@
 
 #include <Eigen/Geometry>
 
+#include "core/log/msgs/geometry_msgs.h"
 #include "core/log/msgs/nav_msgs.h"
+#include "core/log/msgs/rover_msgs.h"
 #include "firmware/mapd/map_log.h"
 #include "mapping/compose/map_composer.h"
 #include "mapping/submap/submap.h"
@@ -50,6 +52,16 @@ class SubmapArchive {
   ArchivedBytes Add(const SubmapRecord& record, const mapping::Submap& submap);
   /// Logs the traversability grid.
   void LogTraversability(const log::nav_msgs::OccupancyGrid& grid);
+  /// Logs one pose-graph factor and flushes it to disk (a crash from then on
+  /// keeps it).
+  void LogFactor(const log::rover_msgs::GraphFactor& factor);
+  /// Logs the graph's origins and the global pose after an update.
+  void LogGraphState(const log::rover_msgs::SubmapOrigins& origins,
+                     const std::optional<log::geometry_msgs::PoseWithCovarianceStamped>& pose);
+  /// Places the submaps at the pose graph's origins (T_world_frame by local
+  /// frame id): archived submaps move in the composed map, later ones are
+  /// placed there. The map frame stays the first submap's frame.
+  void SetOrigins(const std::map<int64_t, Eigen::Isometry3d>& T_world_frame);
   /// Writes the statistics into the log, closes it and exports the composed
   /// map. Idempotent.
   void Close(const std::map<std::string, std::string>& statistics);
@@ -68,6 +80,8 @@ class SubmapArchive {
   mapping::MapComposer composer_;
   /// T_map_local per local frame id; the map frame is the first submap's.
   std::map<uint32_t, Eigen::Isometry3d> T_map_frame_;
+  std::optional<uint32_t> map_frame_;                     ///< the first submap's frame
+  std::map<uint32_t, uint32_t> composed_index_of_frame_;  ///< archived submaps
   uint64_t unplaced_ = 0;
   bool closed_ = false;
 };

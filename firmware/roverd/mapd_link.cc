@@ -66,7 +66,10 @@ MapdLink::MapdLink(ipc::Transport* transport,
                    const std::optional<topics::StereoCalibrationMsg>& calibration)
     : poses_(MakePublisher<topics::PoseMsg>(transport, topics::kPoseTopic)),
       frames_(MakePublisher<topics::StereoFrameMsg>(transport, topics::kStereoFrameTopic)),
-      switches_(MakePublisher<topics::FrameSwitchMsg>(transport, topics::kFrameSwitchTopic)),
+      // History: a restarted mapd receives the switches it missed (its pose
+      // graph needs every one) and recognises its mission by them.
+      switches_(MakePublisher<topics::FrameSwitchMsg>(
+          transport, topics::kFrameSwitchTopic, {.history_capacity = topics::kSwitchHistory})),
       diagnostics_(MakePublisher<topics::DiagnosticsMsg>(transport, topics::kDiagnosticsTopic)) {
   std::string error;
   const std::optional<ipc::Topic> topic =

@@ -8,6 +8,7 @@
 
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "mapping/graph/pose_graph_solver.h"
 
@@ -30,6 +31,20 @@ struct SolveCommandOptions {
 ///   RESULT dataset=... objective=... iterations=... time_s=... final_cost=... F=... chi2=...
 ///   converged=... rejected=... [certified=yes|no lambda_min=... suboptimality_bound=...]
 int RunSolve(const SolveCommandOptions& options, std::ostream& out, std::ostream& err);
+
+struct RebuildCommandOptions {
+  /// mapd's logs of one mission, oldest first (a restarted mapd leaves several).
+  std::vector<std::string> mapd_logs;
+  std::string output;       ///< the g2o file to write
+  std::string keys_output;  ///< optional CSV: g2o vertex id -> rover-graph key
+};
+
+/// `rover-graph rebuild MAPD_LOG... --out OUT.g2o`: reads every factor mapd
+/// logged (damage and malformed factors reported, the rest kept), rebuilds
+/// the rover graph, optimises it from scratch, compares it with mapd's last
+/// online origins and writes it as g2o (vertex 0 is the anchor). Ends with
+///   RESULT factors=... loop_closures=... variables=... final_cost=... time_s=...
+int RunRebuild(const RebuildCommandOptions& options, std::ostream& out, std::ostream& err);
 
 /// `rover-graph info IN.g2o`: dimension, vertex and edge counts, loop
 /// closures, connected components, F and chi2 of the file's initial guess.

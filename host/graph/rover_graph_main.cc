@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
       "rover-graph: pose-graph optimisation on Ceres for g2o files (2D VERTEX_SE2/EDGE_SE2 and\n"
       "3D VERTEX_SE3:QUAT/EDGE_SE3:QUAT). `solve` initialises by chordal relaxation, refines\n"
       "with Levenberg-Marquardt and reports the SE-Sync objective F next to its own cost, so\n"
-      "results compare with published certified optima."};
+      "results compare with published certified optima. `rebuild` turns a mission's mapd logs\n"
+      "into the rover graph, re-optimised, as g2o."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rover-graph 0.1.0");
 
@@ -98,9 +99,23 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   solve->add_flag("-q,--quiet", quiet, "no per-iteration progress lines");
 
+  rover::host::RebuildCommandOptions rebuild_options;
+  auto* rebuild = app.add_subcommand(
+      "rebuild",
+      "Rebuild a mission's rover graph from mapd's logs (every factor mapd logged as it added\n"
+      "it), optimise it from scratch, compare with mapd's last online origins and write it as\n"
+      "g2o (vertex 0 is the anchored first origin)");
+  rebuild->add_option("MAPD_LOG", rebuild_options.mapd_logs, "mapd logs (.mcap), oldest first")
+      ->required()
+      ->check(CLI::ExistingFile);
+  rebuild->add_option("--out", rebuild_options.output, "g2o file to write")->required();
+  rebuild->add_option("--keys", rebuild_options.keys_output,
+                      "also write a CSV mapping g2o vertex ids to graph keys (s0_3, x0_17, l4)");
+
   CLI11_PARSE(app, argc, argv);
 
   if (*info) return rover::host::RunInfo(info_path, std::cout, std::cerr);
+  if (*rebuild) return rover::host::RunRebuild(rebuild_options, std::cout, std::cerr);
   if (*solve) {
     static const std::map<std::string, Objective> kObjectives = {{"chi2", Objective::kChi2},
                                                                  {"sesync", Objective::kSeSync}};

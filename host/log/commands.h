@@ -56,6 +56,10 @@ struct MapOptions {
   bool write_ply = true;
   /// Compose the point cloud (needed for the .ply); --no-cloud clears it.
   bool compose_cloud = true;
+  /// Place submaps at the pose graph's optimised origins when the mapd logs
+  /// hold them (the last log's last update); false (--chain): by the frame
+  /// switches only, as the filter saw them.
+  bool use_graph = true;
   /// Progress lines on `err` once at least this many submaps are composed.
   std::size_t progress_min_submaps = 20;
 };

@@ -14,6 +14,7 @@
 #include "mapping/compose/map_composer.h"
 #include "mapping/compose/map_export.h"
 #include "mapping/compose/submap_log.h"
+#include "mapping/slam/graph_log.h"
 
 namespace rover::host {
 namespace {
@@ -119,6 +120,18 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
   } else {
     origins = ChainSubmapOrigins(logs.front().submaps);
   }
+  // The pose graph's optimised origins, as mapd composed its map: the last
+  // update of the newest log that has one (a restarted mapd carries the
+  // whole graph on).
+  std::size_t graph_placed = 0;
+  if (options.use_graph) {
+    for (auto path = options.mapd_logs.rbegin(); path != options.mapd_logs.rend(); ++path) {
+      const mapping::GraphLogContents graph = mapping::ReadGraphLogs({*path});
+      if (!graph.last_origins) continue;
+      graph_placed = mapping::PlaceAtGraphOrigins(*graph.last_origins, &origins);
+      break;
+    }
+  }
 
   // The submaps that can be placed (mapping/compose's one placement rule).
   const mapping::SubmapPlacements placement = mapping::PlaceLoggedSubmaps(logs, origins);
@@ -154,7 +167,7 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
       << (options.roverd_log.empty() ? "the first submap's frame (chained by SubmapInfo origins)"
                                      : "frame 0 of " + options.roverd_log + " (" +
                                            std::to_string(origins.size()) + " frame(s) placed)")
-      << "\n";
+      << "; " << graph_placed << " frame(s) at the pose graph's optimised origins\n";
   for (std::size_t l = 0; l < logs.size(); ++l) {
     const mapping::SubmapLog& log = logs[l];
     out << "log " << l + 1 << ": " << options.mapd_logs[l] << "\n";

@@ -122,6 +122,7 @@ int main(int argc, char** argv) {
   rover::host::MapOptions map_options;
   std::vector<std::string> map_formats;
   bool map_no_cloud = false;
+  bool map_chain = false;
   auto* map_command = app.add_subcommand(
       "map",
       "Extract the global map from mapd's logs into STEM.bt, STEM.ot, STEM.ply (view with\n"
@@ -155,6 +156,9 @@ int main(int argc, char** argv) {
       ->required();
   map_command->add_flag("--no-cloud", map_no_cloud,
                         "do not compose the point cloud (faster, less memory; no .ply)");
+  map_command->add_flag("--chain", map_chain,
+                        "place submaps by the filter's frame switches only, not at the pose "
+                        "graph's optimised origins that mapd logged");
   map_command
       ->add_option("--format", map_formats, "files to write, comma-separated (default: bt,ot,ply)")
       ->delimiter(',')
@@ -174,6 +178,7 @@ int main(int argc, char** argv) {
   if (*list) return rover::host::RunList(list_options, std::cout, std::cerr);
   if (*map_command) {
     map_options.compose_cloud = !map_no_cloud;
+    map_options.use_graph = !map_chain;
     if (!map_formats.empty()) {
       const auto has = [&](const char* f) {
         return std::find(map_formats.begin(), map_formats.end(), f) != map_formats.end();

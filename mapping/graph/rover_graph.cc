@@ -67,6 +67,7 @@ RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
   o.num_threads = node.GetInRange<int>("num_threads", 1, 256, o.num_threads);
   o.compute_origin_covariances =
       node.Get<bool>("compute_origin_covariances", o.compute_origin_covariances);
+  o.incremental = node.Get<bool>("incremental", o.incremental);
   return o;
 }
 
@@ -81,6 +82,7 @@ struct RoverGraph::Factor {
   std::optional<GraphKey> b;  // Empty for a prior.
   Eigen::Isometry3d Z = Eigen::Isometry3d::Identity();
   Matrix6d information = Matrix6d::Identity();
+  Matrix6d covariance = Matrix6d::Identity();  // As given: for covariance propagation.
   bool robust = false;
   bool in_problem = false;
 };
@@ -99,6 +101,7 @@ class RoverGraph::Impl {
     CheckFinite(f.Z, what);
     (void)CheckedInverse(covariance, what);
     f.information = InformationFromCovariance(f.Z, covariance);
+    f.covariance = 0.5 * (covariance + covariance.transpose());
     variables_[f.a];
     if (f.b) variables_[*f.b];
     factors_.push_back(std::move(f));
@@ -145,29 +148,102 @@ class RoverGraph::Impl {
         queue.push_back(forward ? *f.b : f.a);
       }
     }
-    std::vector<std::string> loose;
+    unanchored_.clear();
     for (const auto& [key, v] : variables_) {
-      if (!v.initialized) loose.push_back(key.ToString());
-    }
-    if (!loose.empty()) {
-      std::string names;
-      for (size_t k = 0; k < loose.size() && k < 10; ++k) names += (k ? ", " : "") + loose[k];
-      if (loose.size() > 10) names += ", ...";
-      throw GraphError("gauge problem: " + std::to_string(loose.size()) +
-                       " variable(s) not connected to any prior (unanchored component): " + names);
+      if (!v.initialized) unanchored_.push_back(key);
     }
   }
 
-  RoverGraphSummary Optimize() {
-    RoverGraphSummary out;
-    Initialise();
+  // A factor can enter the problem once both its variables are anchored.
+  bool Ready(const Factor& f) const {
+    return variables_.at(f.a).initialized && (!f.b || variables_.at(*f.b).initialized);
+  }
+
+  // True when the factors not yet in the problem only hang new variables
+  // off the graph as a forest (each new variable reached by exactly one new
+  // factor, priors counting as links to the anchored graph): composing them
+  // then gives every new factor a zero residual, so the optimum of the
+  // variables already there does not move and no solve is needed.
+  bool PendingFactorsExtendTheGraph() const {
+    std::map<GraphKey, GraphKey> parent;               // union-find over new variables
+    const GraphKey anchored = GraphKey::Landmark(-1);  // stands for the existing graph
+    const auto root = [&](GraphKey k) {
+      if (const auto it = variables_.find(k); it != variables_.end() && it->second.in_problem) {
+        return anchored;
+      }
+      while (parent.count(k) != 0 && parent.at(k) != k) k = parent.at(k);
+      return k;
+    };
+    for (const Factor& f : factors_) {
+      if (f.in_problem || !Ready(f)) continue;
+      const GraphKey ra = root(f.a);
+      const GraphKey rb = f.b ? root(*f.b) : anchored;
+      if (ra == rb) return false;  // closes a loop (or joins two old variables)
+      if (ra == anchored) {
+        parent[rb] = ra;
+      } else {
+        parent[ra] = rb;
+      }
+      if (parent.count(ra) == 0) parent[ra] = ra;
+      if (parent.count(rb) == 0) parent[rb] = rb;
+    }
+    return true;
+  }
+
+  // Marginal covariance of each new origin from its parent's, through the
+  // composition T_b = T_a Z: with the tangent [dt (world); dphi (right)] and
+  // Z's covariance over [dp (frame a); dtheta (right)],
+  //   Sigma_b = J_a Sigma_a J_a^T + J_z Sigma_z J_z^T,
+  //   J_a = [[I, -R_a [t_z]x], [0, R_z^T]],  J_z = [[R_a, 0], [0, I]].
+  // For a leaf this is the exact (linearised) marginal. Priors give their own
+  // covariance. Returns false if some new origin cannot be reached that way.
+  bool PropagateCovariancesToNewOrigins() {
+    bool progress = true;
+    std::vector<const Factor*> pending;
+    for (const Factor& f : factors_) {
+      if (!f.in_problem && Ready(f)) pending.push_back(&f);
+    }
+    while (progress) {
+      progress = false;
+      for (const Factor* f : pending) {
+        if (!f->b) {
+          if (f->a.type == GraphKey::Type::kOrigin && origin_covariance_.count(f->a) == 0) {
+            origin_covariance_[f->a] = f->covariance;
+            progress = true;
+          }
+          continue;
+        }
+        const GraphKey& b = *f->b;
+        if (b.type != GraphKey::Type::kOrigin || origin_covariance_.count(b) != 0) continue;
+        const auto a_cov = origin_covariance_.find(f->a);
+        if (a_cov == origin_covariance_.end()) continue;
+        const Eigen::Matrix3d R_a = PoseFromParameters(variables_.at(f->a).x.data()).linear();
+        Matrix6d J_a = Matrix6d::Identity();
+        J_a.topRightCorner<3, 3>() = -R_a * skew(f->Z.translation());
+        J_a.bottomRightCorner<3, 3>() = f->Z.linear().transpose();
+        Matrix6d J_z = Matrix6d::Identity();
+        J_z.topLeftCorner<3, 3>() = R_a;
+        origin_covariance_[b] =
+            J_a * a_cov->second * J_a.transpose() + J_z * f->covariance * J_z.transpose();
+        progress = true;
+      }
+    }
+    for (const Factor* f : pending) {
+      for (const GraphKey& k : {f->a, f->b.value_or(f->a)}) {
+        if (k.type == GraphKey::Type::kOrigin && origin_covariance_.count(k) == 0) return false;
+      }
+    }
+    return true;
+  }
+
+  void AddPendingToProblem() {
     for (auto& [key, v] : variables_) {
-      if (v.in_problem) continue;
+      if (v.in_problem || !v.initialized) continue;
       problem_->AddParameterBlock(v.x.data(), 7, &manifold_);
       v.in_problem = true;
     }
     for (Factor& f : factors_) {
-      if (f.in_problem) continue;
+      if (f.in_problem || !Ready(f)) continue;
       ceres::LossFunction* loss = f.robust ? &cauchy_ : nullptr;
       double* a = variables_.at(f.a).x.data();
       if (f.b) {
@@ -178,6 +254,32 @@ class RoverGraph::Impl {
       }
       f.in_problem = true;
     }
+  }
+
+  RoverGraphSummary Optimize() {
+    RoverGraphSummary out;
+    Initialise();
+    out.unanchored = unanchored_;
+    const Clock::time_point start = Clock::now();
+    if (options_.incremental && solved_once_ && PendingFactorsExtendTheGraph()) {
+      // Exact without a solve (see above); only the new covariances are due.
+      const bool covariances_known =
+          !options_.compute_origin_covariances || PropagateCovariancesToNewOrigins();
+      AddPendingToProblem();
+      out.variables = static_cast<int>(variables_.size());
+      out.factors = static_cast<int>(factors_.size());
+      out.converged = true;
+      out.final_cost = out.initial_cost = last_cost_;
+      if (covariances_known) {
+        out.solve_time_s = Seconds(start);
+        return out;
+      }
+    }
+    return Solve(out);
+  }
+
+  RoverGraphSummary Solve(RoverGraphSummary out) {
+    AddPendingToProblem();
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     so.sparse_linear_algebra_library_type =
@@ -197,6 +299,9 @@ class RoverGraph::Impl {
     out.initial_cost = summary.initial_cost;
     out.final_cost = summary.final_cost;
     out.converged = summary.termination_type == ceres::CONVERGENCE;
+    out.solved = true;
+    solved_once_ = true;
+    last_cost_ = summary.final_cost;
     out.variables = static_cast<int>(variables_.size());
     out.factors = static_cast<int>(factors_.size());
     origin_covariance_.clear();
@@ -215,13 +320,15 @@ class RoverGraph::Impl {
     ceres::Covariance covariance(co);
     std::vector<std::pair<const double*, const double*>> blocks;
     for (const auto& [key, v] : variables_) {
-      if (key.type == GraphKey::Type::kOrigin) blocks.emplace_back(v.x.data(), v.x.data());
+      if (key.type == GraphKey::Type::kOrigin && v.in_problem) {
+        blocks.emplace_back(v.x.data(), v.x.data());
+      }
     }
     if (!covariance.Compute(blocks, problem_.get())) {
       throw GraphError("origin covariances: the problem is rank deficient (gauge problem?)");
     }
     for (const auto& [key, v] : variables_) {
-      if (key.type != GraphKey::Type::kOrigin) continue;
+      if (key.type != GraphKey::Type::kOrigin || !v.in_problem) continue;
       Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
       covariance.GetCovarianceBlockInTangentSpace(v.x.data(), v.x.data(), C.data());
       origin_covariance_[key] = C;
@@ -234,6 +341,9 @@ class RoverGraph::Impl {
   std::map<GraphKey, Variable> variables_;
   std::vector<Factor> factors_;
   std::map<GraphKey, Matrix6d> origin_covariance_;
+  std::vector<GraphKey> unanchored_;
+  bool solved_once_ = false;
+  double last_cost_ = 0.0;
   struct FilterPose {
     int64_t submap = 0;
     int64_t pose = 0;
@@ -347,9 +457,11 @@ Matrix6d RoverGraph::OriginCovariance(int robot, int64_t submap) const {
 
 Eigen::Isometry3d RoverGraph::GlobalPose(int robot) const {
   auto it = impl_->current_filter_pose_.find(robot);
-  if (it == impl_->current_filter_pose_.end()) it = impl_->latest_v_.find(robot);
-  if (it == impl_->latest_v_.end()) {
-    throw GraphError("no filter pose for robot " + std::to_string(robot));
+  if (it == impl_->current_filter_pose_.end()) {
+    it = impl_->latest_v_.find(robot);
+    if (it == impl_->latest_v_.end()) {
+      throw GraphError("no filter pose for robot " + std::to_string(robot));
+    }
   }
   return Origin(robot, it->second.submap) * it->second.T_local_body;
 }

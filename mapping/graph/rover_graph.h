@@ -49,9 +49,13 @@ struct RoverGraphOptions {
   int num_threads = 2;
   /// Compute the origin marginals after each Optimize().
   bool compute_origin_covariances = true;
+  /// Skip the solve when the new factors only hang new variables off the
+  /// graph (odometry extending a chain, a new filter pose): composing them is
+  /// then the exact optimum, and new origin marginals are propagated.
+  bool incremental = true;
 
   /// Keys: cauchy_scale, frame_switch_roll_pitch_sigma_rad, max_iterations,
-  /// num_threads, compute_origin_covariances (all optional).
+  /// num_threads, compute_origin_covariances, incremental (all optional).
   static RoverGraphOptions Load(const ConfigNode& node);
 };
 
@@ -81,6 +85,12 @@ struct RoverGraphSummary {
   int variables = 0;
   int factors = 0;
   bool converged = false;
+  /// False when the update only extended the graph (no solve was needed).
+  bool solved = false;
+  /// Variables no prior reaches (e.g. a robot not yet linked to the team, or
+  /// a chain broken by a refused factor): left out of the solve, with their
+  /// factors, until a factor connects them.
+  std::vector<GraphKey> unanchored;
 };
 
 class RoverGraph {
@@ -133,9 +143,10 @@ class RoverGraph {
 
   /// Adds the factors received since the last call, initialises new
   /// variables, optimises (warm-started) and, if enabled, computes the origin
-  /// marginals. Throws GraphError if there is no prior, or if variables are
-  /// not connected to any prior (gauge problem; the message names them), or
-  /// for NaN input.
+  /// marginals. With options.incremental, factors that only extend the graph
+  /// by new variables (no loop) are composed without a solve. Variables that
+  /// no prior reaches wait outside the solve (summary.unanchored names them).
+  /// Throws GraphError if the graph has no prior at all.
   RoverGraphSummary Optimize();
 
   /// Current estimate of a variable (T_world_key). Throws GraphError if the

@@ -44,6 +44,9 @@ constexpr std::array kAllSchemas = {
     SchemaOf<rover_msgs::EstimatorState>(),
     SchemaOf<rover_msgs::EstimatorFrameSwitch>(),
     SchemaOf<rover_msgs::SubmapInfo>(),
+    SchemaOf<rover_msgs::GraphFactor>(),
+    SchemaOf<rover_msgs::SubmapOrigin>(),
+    SchemaOf<rover_msgs::SubmapOrigins>(),
 };
 
 }  // namespace

@@ -208,6 +208,31 @@ constexpr std::array kOwnTexts = {
             "float64 distance_m\n"
             "uint64 octree_bytes\n"
             "uint64 cloud_bytes"},
+    OwnText{"rover_msgs/GraphFactor",
+            "uint8 PRIOR=0\n"
+            "uint8 FRAME_SWITCH=1\n"
+            "uint8 FILTER_POSE=2\n"
+            "uint8 SUBMAP_MATCH=3\n"
+            "uint8 ROBOT_DETECTION=4\n"
+            "uint8 LANDMARK_OBSERVATION=5\n"
+            "std_msgs/Header header\n"
+            "uint64 id\n"
+            "uint8 kind\n"
+            "string key_a\n"
+            "string key_b\n"
+            "float64[3] p_a_b_m\n"
+            "float64[4] q_a_b_wxyz\n"
+            "float64[36] covariance\n"
+            "bool robust"},
+    OwnText{"rover_msgs/SubmapOrigin",
+            "int32 robot\n"
+            "int64 submap\n"
+            "geometry_msgs/Pose pose\n"
+            "float64[36] covariance"},
+    OwnText{"rover_msgs/SubmapOrigins",
+            "std_msgs/Header header\n"
+            "uint64 update\n"
+            "SubmapOrigin[] origins"},
 };
 
 // The primitive types of the ROS 2 interface definition language.

@@ -9,6 +9,8 @@ namespace {
 // Fewest bytes a LogChannelHealth can occupy (empty topic's length prefix and
 // the counters), used to reject impossible element counts before allocating.
 constexpr size_t kMinLogChannelHealthSize = 24;
+// int32 robot, int64 submap, Pose (7 float64), float64[36] (padding may add 4).
+constexpr size_t kMinSubmapOriginSize = 4 + 8 + 7 * 8 + 36 * 8;
 
 }  // namespace
 
@@ -75,6 +77,52 @@ bool Deserialize(CdrReader& reader, SubmapInfo* msg) {
          reader.ReadU64("cloud_bytes", &msg->cloud_bytes);
 }
 
+void Serialize(const GraphFactor& msg, CdrWriter& writer) {
+  Serialize(msg.header, writer);
+  writer.WriteU64(msg.id);
+  writer.WriteU8(msg.kind);
+  writer.WriteString(msg.key_a);
+  writer.WriteString(msg.key_b);
+  writer.WriteF64Array(msg.p_a_b_m);
+  writer.WriteF64Array(msg.q_a_b_wxyz);
+  writer.WriteF64Array(msg.covariance);
+  writer.WriteBool(msg.robust);
+}
+
+void Serialize(const SubmapOrigin& msg, CdrWriter& writer) {
+  writer.WriteI32(msg.robot);
+  writer.WriteI64(msg.submap);
+  Serialize(msg.pose, writer);
+  writer.WriteF64Array(msg.covariance);
+}
+
+void Serialize(const SubmapOrigins& msg, CdrWriter& writer) {
+  Serialize(msg.header, writer);
+  writer.WriteU64(msg.update);
+  writer.WriteSequenceSize(msg.origins.size());
+  for (const SubmapOrigin& origin : msg.origins) Serialize(origin, writer);
+}
+
+bool Deserialize(CdrReader& reader, GraphFactor* msg) {
+  return reader.ReadNested("header", &msg->header) && reader.ReadU64("id", &msg->id) &&
+         reader.ReadU8("kind", &msg->kind) && reader.ReadString("key_a", &msg->key_a) &&
+         reader.ReadString("key_b", &msg->key_b) && reader.ReadF64Array("p_a_b_m", msg->p_a_b_m) &&
+         reader.ReadF64Array("q_a_b_wxyz", msg->q_a_b_wxyz) &&
+         reader.ReadF64Array("covariance", msg->covariance) &&
+         reader.ReadBool("robust", &msg->robust);
+}
+
+bool Deserialize(CdrReader& reader, SubmapOrigin* msg) {
+  return reader.ReadI32("robot", &msg->robot) && reader.ReadI64("submap", &msg->submap) &&
+         reader.ReadNested("pose", &msg->pose) &&
+         reader.ReadF64Array("covariance", msg->covariance);
+}
+
+bool Deserialize(CdrReader& reader, SubmapOrigins* msg) {
+  return reader.ReadNested("header", &msg->header) && reader.ReadU64("update", &msg->update) &&
+         reader.ReadSequence("origins", &msg->origins, kMinSubmapOriginSize);
+}
+
 }  // namespace rover_msgs
 
 std::string_view MessageTraits<rover_msgs::LogChannelHealth>::Definition() {
@@ -87,6 +135,18 @@ std::string_view MessageTraits<rover_msgs::LogHealth>::Definition() {
 
 std::string_view MessageTraits<rover_msgs::SubmapInfo>::Definition() {
   return internal::CachedDefinition<rover_msgs::SubmapInfo>();
+}
+
+std::string_view MessageTraits<rover_msgs::GraphFactor>::Definition() {
+  return internal::CachedDefinition<rover_msgs::GraphFactor>();
+}
+
+std::string_view MessageTraits<rover_msgs::SubmapOrigin>::Definition() {
+  return internal::CachedDefinition<rover_msgs::SubmapOrigin>();
+}
+
+std::string_view MessageTraits<rover_msgs::SubmapOrigins>::Definition() {
+  return internal::CachedDefinition<rover_msgs::SubmapOrigins>();
 }
 
 }  // namespace rover::log

@@ -11,6 +11,7 @@
 
 #include "core/log/cdr/cdr_reader.h"
 #include "core/log/cdr/cdr_writer.h"
+#include "core/log/msgs/geometry_msgs.h"
 #include "core/log/msgs/message_traits.h"
 #include "core/log/msgs/std_msgs.h"
 
@@ -65,12 +66,69 @@ struct SubmapInfo {
   friend bool operator==(const SubmapInfo&, const SubmapInfo&) = default;
 };
 
+/// rover_msgs/msg/GraphFactor: one factor of the rover's pose graph, as mapd
+/// added it (mapd logs every factor when it adds it, so a restarted mapd, or
+/// `rover-graph` offline, rebuilds the same graph from the log). Keys are
+/// GraphKey names ("s0_3": origin 3 of robot 0; "x0_17"; "l4"); `key_b` is
+/// empty for a prior. The measurement is T_a_b (for a prior T_world_a); the
+/// covariance is row-major over [dp (m, frame a); dtheta (rad, right)]. For a
+/// frame switch (kind W) only rows/columns 0, 1, 2, 5 are used: the filter's
+/// 4x4 over [dp; dyaw]. `id` counts the robot's factors from 1, so the same
+/// factor read twice (two logs of one mission) is recognised.
+struct GraphFactor {
+  static constexpr uint8_t kPrior = 0;
+  static constexpr uint8_t kFrameSwitch = 1;          ///< w
+  static constexpr uint8_t kFilterPose = 2;           ///< v
+  static constexpr uint8_t kSubmapMatch = 3;          ///< c
+  static constexpr uint8_t kRobotDetection = 4;       ///< d
+  static constexpr uint8_t kLandmarkObservation = 5;  ///< o
+  std_msgs::Header header;
+  uint64_t id = 0;
+  uint8_t kind = kPrior;
+  std::string key_a;
+  std::string key_b;
+  std::array<double, 3> p_a_b_m{};
+  std::array<double, 4> q_a_b_wxyz{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 36> covariance{};
+  bool robust = false;
+
+  friend bool operator==(const GraphFactor&, const GraphFactor&) = default;
+};
+
+/// rover_msgs/msg/SubmapOrigin: one optimised submap origin T_world_origin
+/// with its marginal covariance (row-major, [dt (m, world); dphi (rad,
+/// right)]; all zero when not computed).
+struct SubmapOrigin {
+  int32_t robot = 0;
+  int64_t submap = 0;
+  geometry_msgs::Pose pose;
+  std::array<double, 36> covariance{};
+
+  friend bool operator==(const SubmapOrigin&, const SubmapOrigin&) = default;
+};
+
+/// rover_msgs/msg/SubmapOrigins: every submap origin after one update of the
+/// pose graph (header.frame_id "world"; stamp: the newest input's).
+struct SubmapOrigins {
+  std_msgs::Header header;
+  uint64_t update = 0;  ///< counts the graph's updates from 1
+  std::vector<SubmapOrigin> origins;
+
+  friend bool operator==(const SubmapOrigins&, const SubmapOrigins&) = default;
+};
+
 void Serialize(const LogChannelHealth& msg, CdrWriter& writer);
 void Serialize(const LogHealth& msg, CdrWriter& writer);
 void Serialize(const SubmapInfo& msg, CdrWriter& writer);
 bool Deserialize(CdrReader& reader, LogChannelHealth* msg);
 bool Deserialize(CdrReader& reader, LogHealth* msg);
 bool Deserialize(CdrReader& reader, SubmapInfo* msg);
+void Serialize(const GraphFactor& msg, CdrWriter& writer);
+void Serialize(const SubmapOrigin& msg, CdrWriter& writer);
+void Serialize(const SubmapOrigins& msg, CdrWriter& writer);
+bool Deserialize(CdrReader& reader, GraphFactor* msg);
+bool Deserialize(CdrReader& reader, SubmapOrigin* msg);
+bool Deserialize(CdrReader& reader, SubmapOrigins* msg);
 
 }  // namespace rover_msgs
 
@@ -89,6 +147,24 @@ struct MessageTraits<rover_msgs::LogHealth> {
 template <>
 struct MessageTraits<rover_msgs::SubmapInfo> {
   static constexpr std::string_view kName = "rover_msgs/msg/SubmapInfo";
+  static std::string_view Definition();
+};
+
+template <>
+struct MessageTraits<rover_msgs::GraphFactor> {
+  static constexpr std::string_view kName = "rover_msgs/msg/GraphFactor";
+  static std::string_view Definition();
+};
+
+template <>
+struct MessageTraits<rover_msgs::SubmapOrigin> {
+  static constexpr std::string_view kName = "rover_msgs/msg/SubmapOrigin";
+  static std::string_view Definition();
+};
+
+template <>
+struct MessageTraits<rover_msgs::SubmapOrigins> {
+  static constexpr std::string_view kName = "rover_msgs/msg/SubmapOrigins";
   static std::string_view Definition();
 };
 

@@ -92,6 +92,10 @@ struct FrameSwitchMsg {
   std::array<double, 16> covariance{};
 };
 
+/// Frame switches kept by the publisher for late subscribers (iceoryx caps
+/// history at 16): a restarted mapd catches up on this many.
+inline constexpr uint64_t kSwitchHistory = 16;
+
 /// Why mapd asks for a new submap.
 enum class SwitchReason : uint32_t {
   kDistance = 0,       ///< the distance driven in the submap exceeded its limit

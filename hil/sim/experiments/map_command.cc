@@ -1,5 +1,6 @@
 #include "hil/sim/experiments/map_command.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +20,7 @@
 #include "mapping/compose/map_composer.h"
 #include "mapping/compose/map_export.h"
 #include "mapping/compose/submap_log.h"
+#include "mapping/slam/graph_log.h"
 
 namespace rover::sim::experiments {
 
@@ -100,6 +102,44 @@ std::string Num(double v, int digits) {
   return text;
 }
 
+// The submaps at the pose graph's optimised origins (mapping::
+// PlaceAtGraphOrigins), and the graph's final global pose against the truth.
+// A restarted mapd's log holds the whole graph again; later logs win.
+void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
+                         const sim::RoverTrajectory& trajectory, const MissionFacts& mission,
+                         std::map<uint32_t, Eigen::Isometry3d>* origins, MapResult* r,
+                         std::ostream& report) {
+  for (const std::string& path : mapd_logs) {
+    const mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
+    for (const std::string& p : g.problems) report << "    graph: " << p << "\n";
+    for (const mapping::GraphFactorRecord& f : g.factors) {
+      if (f.kind == mapping::FactorKind::kSubmapMatch) ++r->loop_closures;
+    }
+    if (!g.last_origins) continue;
+    const std::optional<Eigen::Isometry3d> T_world_graph =
+        mapping::GraphInMap(*g.last_origins, *origins);
+    if (!T_world_graph) continue;
+    r->graph_origins += mapping::PlaceAtGraphOrigins(*g.last_origins, origins);
+    if (!g.last_global_pose) continue;
+    const Time stamp = log::FromRosTime(g.last_global_pose->header.stamp);
+    const Eigen::Vector3d p_est =
+        (*T_world_graph * mapping::FromPoseMsg(g.last_global_pose->pose.pose)).translation();
+    const double t_s = (stamp - mission.start).ToSeconds();
+    const Eigen::Vector3d p_true = trajectory.Evaluate(t_s).p_world_body;
+    double distance_m = 0.0;
+    Eigen::Vector3d previous =
+        trajectory.Evaluate((mission.init_stamp - mission.start).ToSeconds()).p_world_body;
+    for (double t = (mission.init_stamp - mission.start).ToSeconds(); t <= t_s; t += 0.1) {
+      const Eigen::Vector3d p = trajectory.Evaluate(t).p_world_body;
+      distance_m += (p - previous).norm();
+      previous = p;
+    }
+    r->slam_final_error_m = (p_est - p_true).norm();
+    r->slam_final_error_pct = distance_m > 0.0 ? 100.0 * r->slam_final_error_m / distance_m
+                                               : std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
 }  // namespace
 
 MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
@@ -131,6 +171,7 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   for (auto& [frame, T] : origins) T = T_world_local0 * T;
 
   MapResult r;
+  PlaceAtGraphOrigins(o.mapd_logs, trajectory, mission, &origins, &r, report);
   std::vector<mapping::SubmapLog> logs;
   uint64_t submap_bytes = 0;
   for (const std::string& path : o.mapd_logs) {
@@ -195,7 +236,10 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
                     ? 100.0 * r.submap_bytes_per_s / r.raw_stereo_bytes_per_s
                     : std::numeric_limits<double>::quiet_NaN(),
                 3)
-         << " %)\n";
+         << " %)\n"
+         << "  slam       final error " << Num(r.slam_final_error_m, 3) << " m ("
+         << Num(r.slam_final_error_pct, 4) << " % of distance), " << r.loop_closures
+         << " loop closures, " << r.graph_origins << " submaps at the graph's origins\n";
   return r;
 }
 
@@ -205,7 +249,8 @@ std::string MapResultFields(const MapResult& r) {
          " obstacle_precision=" + Num(q.obstacle_precision, 4) +
          " obstacle_recall=" + Num(q.obstacle_recall, 4) + " submaps=" + std::to_string(r.submaps) +
          " submap_bytes_per_s=" + Num(r.submap_bytes_per_s, 0) +
-         " raw_stereo_bytes_per_s=" + Num(r.raw_stereo_bytes_per_s, 0);
+         " raw_stereo_bytes_per_s=" + Num(r.raw_stereo_bytes_per_s, 0) +
+         " loop_closures=" + std::to_string(r.loop_closures);
 }
 
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err) {

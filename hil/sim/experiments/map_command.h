@@ -7,6 +7,7 @@
 // mission's scenario, seed and start time) and mapd's log(s) (submaps),
 // composes the global map in the world frame and scores it.
 
+#include <limits>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -38,6 +39,12 @@ struct MapResult {
   double raw_stereo_bytes_per_s = 0.0;
   double compose_ms = 0.0;
   uint64_t map_memory_bytes = 0;
+  /// The pose graph's last global pose against the truth at its stamp (nan
+  /// when mapd logged none), over the true distance driven up to then.
+  double slam_final_error_m = std::numeric_limits<double>::quiet_NaN();
+  double slam_final_error_pct = std::numeric_limits<double>::quiet_NaN();
+  uint64_t loop_closures = 0;  ///< submap matches in the graph (c factors)
+  uint64_t graph_origins = 0;  ///< submaps placed at the graph's origins
 };
 
 /// Evaluates; throws std::runtime_error naming the file or the problem.

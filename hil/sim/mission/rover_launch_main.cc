@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -73,12 +74,22 @@ void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
     std::cout << "map (rover-sim map " << options.mission_log << "):\n";
     const rover::sim::experiments::MapResult r =
         rover::sim::experiments::EvaluateMission(options, std::cout);
+    // roverd-sim cannot know the graph's result: mapd's log has it.
+    const std::string slam_field = " slam_final_err_pct=";
+    const std::size_t at = line.find(slam_field);
+    if (at != std::string::npos) {
+      const std::size_t begin = at + slam_field.size();
+      const std::size_t end = line.find(' ', begin);
+      char value[32];
+      std::snprintf(value, sizeof(value), "%.4f", r.slam_final_error_pct);
+      line.replace(begin, end - begin, std::isfinite(r.slam_final_error_pct) ? value : "nan");
+    }
     std::cout << line << " " << rover::sim::experiments::MapResultFields(r) << "\n";
   } catch (const std::exception& e) {
     Say("map evaluation: " + std::string(e.what()));
     std::cout << line
               << " map_precision=nan map_recall=nan obstacle_precision=nan obstacle_recall=nan "
-                 "submaps=0 submap_bytes_per_s=nan raw_stereo_bytes_per_s=nan\n";
+                 "submaps=0 submap_bytes_per_s=nan raw_stereo_bytes_per_s=nan loop_closures=0\n";
   }
 }
 

@@ -21,7 +21,8 @@ int main(int argc, char** argv) {
       "line is\n"
       "  RESULT scenario=… distance_m=… filter_final_err_pct=… slam_final_err_pct=…\n"
       "         imu_drops=… frame_drops=… loop_latency_us_p999=… log=PATH\n"
-      "(slam_final_err_pct is nan until mapd runs the pose graph; loop_latency_us_p999 is the\n"
+      "(slam_final_err_pct is nan here: rover-launch fills it from mapd's log; "
+      "loop_latency_us_p999 is the\n"
       "IMU loop's sample-to-estimate latency in real time, the estimator step's wall time in\n"
       "lockstep, where sensor stamps are simulated time).\n"};
   rover::sim::MissionOptions options;

@@ -2,13 +2,15 @@
 // rover-launch runs RouDi's clients roverd-sim (real time) and mapd; the test
 // kills mapd with SIGKILL mid-mission. roverd's IMU loop must show no gap in
 // its log, the launcher must restart mapd, and the new mapd must resume with
-// a new submap: a frame switch after the kill.
+// a new submap: a frame switch after the kill. The new mapd carries on with
+// the pose graph the killed one logged.
 
 #include <gtest/gtest.h>
 
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -20,6 +22,7 @@
 #include "estimator/io/estimator_log_records.h"
 #include "estimator/io/log_replay.h"
 #include "firmware/runtime/process/child_process.h"
+#include "mapping/slam/graph_log.h"
 #include "tests/support/roudi_process.h"
 #include "tests/support/temp_dir.h"
 
@@ -71,12 +74,29 @@ TEST(MapdCrashTest, KillingMapdLeavesNoGapInTheImuLoopAndMapdResumesWithANewSubm
   const fs::path run_dir = dir.path() / "run";
   const fs::path output = dir.path() / "launch.txt";
   const double duration_s = 14.0;
-  runtime::ChildProcess launcher = runtime::ChildProcess::Spawn(
-      {.argv = {ROVER_LAUNCH, "--mapd", ROVER_MAPD, "--roverd-sim", ROVER_ROVERD_SIM, "--run-dir",
-                run_dir.string(), "--restart-backoff-s", "0.5", "--", "--sim", "short", "--seed",
-                "1", "--realtime", "--max-duration-s", std::to_string(duration_s), "--out",
-                dir.path().string()},
-       .output_file = output.string()});
+  runtime::ChildProcess launcher =
+      runtime::ChildProcess::Spawn({.argv = {ROVER_LAUNCH,
+                                             "--mapd",
+                                             ROVER_MAPD,
+                                             "--roverd-sim",
+                                             ROVER_ROVERD_SIM,
+                                             "--run-dir",
+                                             run_dir.string(),
+                                             "--restart-backoff-s",
+                                             "0.5",
+                                             "--evaluate-map",
+                                             dir.path().string(),
+                                             "--",
+                                             "--sim",
+                                             "short",
+                                             "--seed",
+                                             "1",
+                                             "--realtime",
+                                             "--max-duration-s",
+                                             std::to_string(duration_s),
+                                             "--out",
+                                             dir.path().string()},
+                                    .output_file = output.string()});
   const pid_t first = WaitForPid(run_dir / "mapd.pid", 0, Duration::Seconds(30));
   ASSERT_GT(first, 0) << testing::ReadTextFile(output);
   // Let the mission run until the first mapd has its submap (the status
@@ -122,6 +142,46 @@ TEST(MapdCrashTest, KillingMapdLeavesNoGapInTheImuLoopAndMapdResumesWithANewSubm
   EXPECT_LT(switches.front().stamp_ns, killed_at.nanoseconds());
   EXPECT_GT(switches.back().stamp_ns, killed_at.nanoseconds());
   EXPECT_NE(text.find("restart "), std::string::npos) << "the new mapd's submap\n" << text;
+
+  // The pose graph survives the kill: the restarted mapd took over every
+  // factor the first one had logged (same ids, same numbers), added the
+  // switches it missed, and its log holds one w factor per switch roverd made.
+  const auto mapd_log_of = [&](pid_t pid) {
+    for (const auto& e : fs::directory_iterator(dir.path())) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind("mapd-", 0) == 0 &&
+          name.find("-" + std::to_string(pid) + ".mcap") != std::string::npos) {
+        return e.path().string();
+      }
+    }
+    return std::string();
+  };
+  const std::string first_log = mapd_log_of(first);
+  const std::string second_log = mapd_log_of(second);
+  ASSERT_FALSE(first_log.empty()) << text;
+  ASSERT_FALSE(second_log.empty()) << text;
+  const mapping::GraphLogContents before = mapping::ReadGraphLogs({first_log});
+  const mapping::GraphLogContents after = mapping::ReadGraphLogs({second_log});
+  EXPECT_TRUE(before.truncated) << "mapd was killed mid-log";
+  ASSERT_GE(before.factors.size(), 2u) << "the prior and the first switch";
+  ASSERT_GE(after.factors.size(), before.factors.size());
+  for (std::size_t k = 0; k < before.factors.size(); ++k) {
+    const mapping::GraphFactorRecord& a = before.factors[k];
+    const mapping::GraphFactorRecord& b = after.factors[k];
+    EXPECT_EQ(a.id, b.id);
+    EXPECT_EQ(a.Describe(), b.Describe());
+    EXPECT_EQ(a.T_a_b.matrix(), b.T_a_b.matrix()) << a.Describe();
+    EXPECT_EQ(a.covariance, b.covariance) << a.Describe();
+  }
+  std::set<int64_t> switched;
+  for (const mapping::GraphFactorRecord& f : after.factors) {
+    if (f.kind == mapping::FactorKind::kFrameSwitch) switched.insert(f.a.index);
+  }
+  EXPECT_EQ(switched.size(), switches.size()) << "one w factor per switch, none lost or doubled";
+  for (const auto& sw : switches) {
+    EXPECT_EQ(switched.count(sw.old_frame_id), 1u) << "switch from frame " << sw.old_frame_id;
+  }
+  EXPECT_NE(text.find("resuming the pose graph"), std::string::npos) << text;
 
   const estimator::io::ReplayResult replay = estimator::io::ReplayLog(log_path);
   EXPECT_TRUE(replay.bit_exact) << replay.first_difference;

@@ -5,6 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
+#include "core/geometry/yaw.h"
 #include "core/ipc/in_process_transport.h"
 #include "estimator/eskf/eskf_output.h"
 
@@ -22,7 +26,8 @@ class MapdTest : public ::testing::Test {
       // topic, and a stereo pair is 2 MB.
       : transport_(ipc::InProcessTransport::Options{.max_queue_capacity = 8}),
         mapd_(MapdOptions{.trigger = {.max_distance_m = 7.0, .max_position_sigma_m = 0.1},
-                          .pose_queue = 8},
+                          .pose_queue = 8,
+                          .global_pose_period = Duration::Zero()},
               &transport_),
         poses_(transport_.MakePublisher<topics::PoseMsg>(T(topics::kPoseTopic))),
         switches_(transport_.MakePublisher<topics::FrameSwitchMsg>(T(topics::kFrameSwitchTopic))),
@@ -37,6 +42,40 @@ class MapdTest : public ::testing::Test {
     m.p_local_body_m = {x_m, 0.0, 0.0};
     m.position_sigma_m = 0.01;
     ASSERT_TRUE(poses_->Publish(m));
+  }
+
+  void Switch(uint32_t old_frame, double t_s, const Eigen::Vector3d& p, double yaw,
+              double variance = 1e-4) {
+    topics::FrameSwitchMsg sw;
+    sw.old_frame_id = old_frame;
+    sw.new_frame_id = old_frame + 1;
+    sw.stamp_ns = Time::FromSeconds(t_s).nanoseconds();
+    sw.p_old_new_m = {p.x(), p.y(), p.z()};
+    sw.yaw_old_new_rad = yaw;
+    for (int i = 0; i < 4; ++i) sw.covariance[static_cast<std::size_t>(5 * i)] = variance;
+    ASSERT_TRUE(switches_->Publish(sw));
+  }
+
+  // Polls until the graph thread has taken `factors` factors (or 10 s).
+  SlamStats WaitForFactors(uint64_t factors) {
+    for (int i = 0; i < 1000; ++i) {
+      mapd_.Poll();
+      const SlamStats s = mapd_.slam_stats();
+      if (s.factors_added + s.factors_refused >= factors) return s;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return mapd_.slam_stats();
+  }
+
+  // Polls until the graph has `origins` origins and a global pose (or 10 s).
+  SlamSnapshot WaitForGraph(std::size_t origins) {
+    for (int i = 0; i < 1000; ++i) {
+      mapd_.Poll();
+      const SlamSnapshot s = mapd_.slam_snapshot();
+      if (s.origins.size() >= origins && s.T_world_body) return s;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return mapd_.slam_snapshot();
   }
 
   std::vector<topics::FrameSwitchRequestMsg> Requests() {
@@ -133,6 +172,51 @@ TEST_F(MapdTest, IgnoresMessagesOfAnotherTopicsVersion) {
   EXPECT_EQ(mapd_.stats().version_mismatches, 1u);
   EXPECT_EQ(mapd_.stats().poses, 0u);
   EXPECT_TRUE(Requests().empty());
+}
+
+// The frame switches chain the origins in the pose graph (its own thread),
+// and the global pose is the current origin composed with the estimate.
+TEST_F(MapdTest, TheGraphChainsTheSwitchesAndComposesTheGlobalPose) {
+  Pose(1.0, 0, 0.0);
+  mapd_.Poll();
+  Switch(0, 1.5, {7.0, 0.5, 0.1}, 0.3);
+  Pose(2.0, 1, 0.0);
+  mapd_.Poll();
+  Switch(1, 2.5, {6.0, -1.0, 0.0}, -0.2);
+  Pose(3.0, 2, 1.0);
+  const SlamSnapshot snap = WaitForGraph(3);
+  ASSERT_EQ(snap.origins.size(), 3u);
+  const Eigen::Isometry3d s1 = GravityAlignedTransform(Eigen::Vector3d(7.0, 0.5, 0.1), 0.3);
+  const Eigen::Isometry3d s2 = s1 * GravityAlignedTransform(Eigen::Vector3d(6.0, -1.0, 0.0), -0.2);
+  EXPECT_LT((snap.origins.at(0).T_world_origin.matrix() - Eigen::Matrix4d::Identity()).norm(),
+            1e-9);
+  EXPECT_LT((snap.origins.at(1).T_world_origin.matrix() - s1.matrix()).norm(), 1e-6);
+  EXPECT_LT((snap.origins.at(2).T_world_origin.matrix() - s2.matrix()).norm(), 1e-6);
+  // Uncertainty grows along the chain.
+  EXPECT_GT(snap.origins.at(2).covariance.trace(), snap.origins.at(1).covariance.trace());
+  ASSERT_TRUE(snap.T_world_body.has_value());
+  EXPECT_LT((snap.T_world_body->translation() - s2 * Eigen::Vector3d(1.0, 0.0, 0.0)).norm(), 1e-6);
+  const SlamStats stats = mapd_.slam_stats();
+  EXPECT_EQ(stats.factors_added, 3u);  // the prior and two switches
+  EXPECT_EQ(stats.factors_refused, 0u);
+}
+
+// A switch record with a NaN covariance is left out with a message; the
+// frames after it wait outside the graph and the part before carries on.
+TEST_F(MapdTest, ASwitchWithANanCovarianceIsLeftOutAndTheGraphCarriesOn) {
+  Pose(1.0, 0, 0.0);
+  mapd_.Poll();
+  Switch(0, 1.5, {7.0, 0.0, 0.0}, 0.0, std::nan(""));
+  Pose(2.0, 1, 0.0);
+  mapd_.Poll();
+  Switch(1, 2.5, {7.0, 0.0, 0.0}, 0.0);
+  mapd_.Poll();
+  const SlamStats stats = WaitForFactors(2);  // the prior and the second switch
+  const SlamSnapshot snap = mapd_.slam_snapshot();
+  EXPECT_EQ(snap.origins.size(), 1u) << "s0_1 and s0_2 hang off a refused switch";
+  EXPECT_EQ(mapd_.stats().graph_factors_refused, 1u);
+  EXPECT_EQ(stats.factors_added, 2u);
+  EXPECT_EQ(stats.update_errors, 0u);
 }
 
 }  // namespace

@@ -154,6 +154,28 @@ class RandomMessages {
     m->octree_bytes = rng_();
     m->cloud_bytes = rng_();
   }
+  void Fill(rover_msgs::GraphFactor* m) {
+    Fill(&m->header);
+    m->id = rng_();
+    m->kind = static_cast<uint8_t>(Uniform(0, 5));
+    m->key_a = Text(8);
+    m->key_b = Text(8);
+    FillArray(&m->p_a_b_m);
+    FillArray(&m->q_a_b_wxyz);
+    FillArray(&m->covariance);
+    m->robust = Uniform(0, 1) == 1;
+  }
+  void Fill(rover_msgs::SubmapOrigin* m) {
+    m->robot = static_cast<int32_t>(rng_());
+    m->submap = static_cast<int64_t>(rng_());
+    Fill(&m->pose);
+    FillArray(&m->covariance);
+  }
+  void Fill(rover_msgs::SubmapOrigins* m) {
+    Fill(&m->header);
+    m->update = rng_();
+    FillVector(&m->origins);
+  }
   void Fill(nav_msgs::Odometry* m) {
     Fill(&m->header);
     m->child_frame_id = FrameId::Truncated(Text(FrameId::kCapacity));
@@ -303,7 +325,8 @@ using AllMessageTypes = ::testing::Types<
     diagnostic_msgs::DiagnosticArray, rover_msgs::LogChannelHealth, rover_msgs::LogHealth,
     rover_msgs::EstimatorImu, rover_msgs::EstimatorEvent, rover_msgs::EstimatorRelativePose,
     rover_msgs::EstimatorWheelSpeeds, rover_msgs::EstimatorState, rover_msgs::EstimatorFrameSwitch,
-    rover_msgs::SubmapInfo>;
+    rover_msgs::SubmapInfo, rover_msgs::GraphFactor, rover_msgs::SubmapOrigin,
+    rover_msgs::SubmapOrigins>;
 
 /// gtest names for AllMessageTypes instances: the ROS type name.
 struct MessageTypeName {

@@ -1,0 +1,196 @@
+#include "firmware/mapd/slam_worker.h"
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <chrono>
+
+#include "core/geometry/so3.h"
+
+namespace rover::mapd {
+namespace {
+
+// Marginal covariance of T_a * Z from T_a's ([dt world; dphi right]) and Z's
+// ([dp frame a; dtheta right]), to first order.
+mapping::Matrix6d ComposeCovariance(const Eigen::Isometry3d& T_a, const mapping::Matrix6d& C_a,
+                                    const Eigen::Isometry3d& Z, const mapping::Matrix6d& C_z) {
+  mapping::Matrix6d J_a = mapping::Matrix6d::Identity();
+  J_a.topRightCorner<3, 3>() = -T_a.linear() * skew(Z.translation());
+  J_a.bottomRightCorner<3, 3>() = Z.linear().transpose();
+  mapping::Matrix6d J_z = mapping::Matrix6d::Identity();
+  J_z.topLeftCorner<3, 3>() = T_a.linear();
+  return J_a * C_a * J_a.transpose() + J_z * C_z * J_z.transpose();
+}
+
+}  // namespace
+
+SlamWorker::SlamWorker(const mapping::RoverGraphOptions& options, int robot)
+    : robot_(robot), graph_(options), thread_([this] { Run(); }) {}
+
+SlamWorker::~SlamWorker() { Stop(); }
+
+void SlamWorker::Submit(const mapping::GraphFactorRecord& factor) {
+  {
+    const std::lock_guard lock(mutex_);
+    inbox_.push_back(factor);
+  }
+  wake_.notify_all();
+}
+
+void SlamWorker::SetFilterPose(int64_t stamp_ns, uint32_t frame_id,
+                               const Eigen::Isometry3d& T_local_body,
+                               const mapping::Matrix6d& covariance) {
+  {
+    const std::lock_guard lock(mutex_);
+    filter_pose_ = FilterPose{stamp_ns, frame_id, T_local_body, covariance};
+    pose_changed_ = true;
+  }
+  wake_.notify_all();
+}
+
+SlamSnapshot SlamWorker::Latest() const {
+  const std::lock_guard lock(mutex_);
+  return latest_;
+}
+
+SlamStats SlamWorker::Stats() const {
+  const std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+std::vector<std::string> SlamWorker::TakeProblems() {
+  const std::lock_guard lock(mutex_);
+  std::vector<std::string> out;
+  out.swap(problems_);
+  return out;
+}
+
+void SlamWorker::Flush() {
+  std::unique_lock lock(mutex_);
+  idle_.wait(lock, [&] { return stop_ || (inbox_.empty() && !busy_); });
+}
+
+void SlamWorker::Stop() {
+  {
+    const std::lock_guard lock(mutex_);
+    if (stop_ && !thread_.joinable()) return;
+    stop_ = true;
+  }
+  wake_.notify_all();
+  idle_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void SlamWorker::Run() {
+  // Below mapd's main loop: the graph may wait, the stereo pairs may not.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_.wait(lock, [&] { return stop_ || !inbox_.empty() || pose_changed_; });
+    if (stop_) return;
+    std::deque<mapping::GraphFactorRecord> batch;
+    batch.swap(inbox_);
+    pose_changed_ = false;
+    busy_ = true;
+    lock.unlock();
+    UpdateOnce(&batch);
+    lock.lock();
+    busy_ = false;
+    if (inbox_.empty()) idle_.notify_all();
+  }
+}
+
+void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch) {
+  std::vector<std::string> problems;
+  uint64_t added = 0;
+  int64_t stamp_ns = 0;
+  for (const mapping::GraphFactorRecord& f : *batch) {
+    try {
+      mapping::AddToGraph(f, &graph_);
+      ++added;
+      stamp_ns = std::max(stamp_ns, f.stamp_ns);
+    } catch (const std::exception& e) {
+      problems.push_back(std::string("factor left out: ") + e.what());
+    }
+  }
+  std::optional<FilterPose> pose;
+  {
+    const std::lock_guard lock(mutex_);
+    pose = filter_pose_;
+  }
+  SlamSnapshot snap;
+  const auto start = std::chrono::steady_clock::now();
+  bool ok = true;
+  if (added > 0 || latest_.update == 0) {
+    try {
+      snap.summary = graph_.Optimize();
+    } catch (const std::exception& e) {
+      ok = false;
+      problems.push_back(std::string("graph update failed: ") + e.what());
+    }
+  }
+  if (ok && snap.summary.unanchored.size() != unanchored_reported_) {
+    unanchored_reported_ = snap.summary.unanchored.size();
+    if (unanchored_reported_ > 0) {
+      std::string names;
+      for (std::size_t k = 0; k < unanchored_reported_ && k < 8; ++k) {
+        names += (k ? ", " : "") + snap.summary.unanchored[k].ToString();
+      }
+      problems.push_back(std::to_string(unanchored_reported_) +
+                         " variable(s) no prior reaches, left out until a factor links them: " +
+                         names + (unanchored_reported_ > 8 ? ", ..." : ""));
+    }
+  }
+  if (ok) {
+    for (const mapping::GraphKey& key : graph_.Keys()) {
+      if (key.type != mapping::GraphKey::Type::kOrigin || key.robot != robot_) continue;
+      OptimisedOrigin o;
+      try {
+        o.T_world_origin = graph_.Estimate(key);
+      } catch (const std::exception&) {
+        continue;  // unanchored
+      }
+      try {
+        o.covariance = graph_.OriginCovariance(key.robot, key.index);
+      } catch (const std::exception&) {
+        // Not computed (option off): left zero.
+      }
+      snap.origins[key.index] = o;
+    }
+    if (pose) {
+      const auto origin = snap.origins.find(pose->frame_id);
+      if (origin != snap.origins.end()) {
+        snap.T_world_body = origin->second.T_world_origin * pose->T_local_body;
+        snap.global_pose_stamp_ns = pose->stamp_ns;
+        snap.global_pose_frame_id = pose->frame_id;
+        snap.global_pose_covariance =
+            ComposeCovariance(origin->second.T_world_origin, origin->second.covariance,
+                              pose->T_local_body, pose->covariance);
+        stamp_ns = std::max(stamp_ns, pose->stamp_ns);
+      }
+    }
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const std::lock_guard lock(mutex_);
+  stats_.factors_added += added;
+  stats_.factors_refused += batch->size() - added;
+  for (std::string& p : problems) problems_.push_back(std::move(p));
+  if (!ok) {
+    ++stats_.update_errors;
+    return;
+  }
+  if (added > 0) {
+    ++stats_.updates;
+    if (snap.summary.solved) ++stats_.solves;
+    stats_.update_ms.push_back(ms);
+  }
+  snap.update = latest_.update + 1;
+  snap.stamp_ns = std::max(stamp_ns, latest_.stamp_ns);
+  snap.update_ms = ms;
+  if (added == 0) snap.summary = latest_.summary;
+  latest_ = std::move(snap);
+}
+
+}  // namespace rover::mapd
