@@ -90,10 +90,10 @@ void GravityDescriptorOptions::Validate() const {
 
 GravityDescriptorOptions GravityDescriptorOptions::Load(const ConfigNode& node) {
   GravityDescriptorOptions o;
-  o.kind = node.GetEnum<GravityDescriptorKind>(
-      "kind", {{"fourier", GravityDescriptorKind::kFourier},
-               {"oriented", GravityDescriptorKind::kOriented}},
-      o.kind);
+  o.kind = node.GetEnum<GravityDescriptorKind>("kind",
+                                               {{"fourier", GravityDescriptorKind::kFourier},
+                                                {"oriented", GravityDescriptorKind::kOriented}},
+                                               o.kind);
   o.radius_m = node.Get<double>("radius_m", o.radius_m);
   o.azimuth_sectors = node.Get<int>("azimuth_sectors", o.azimuth_sectors);
   o.radial_shells = node.Get<int>("radial_shells", o.radial_shells);

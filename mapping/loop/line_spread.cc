@@ -35,8 +35,8 @@ int CountOffLine(const std::vector<Eigen::Vector3f>& points, double off_line_dis
   if (pairs <= static_cast<std::size_t>(max_samples)) {
     for (std::size_t i = 0; i < n; ++i) {
       for (std::size_t j = i + 1; j < n; ++j) {
-        best_on = std::max(best_on, OnLine(points, points[i].head<2>(), points[j].head<2>(),
-                                           distance));
+        best_on =
+            std::max(best_on, OnLine(points, points[i].head<2>(), points[j].head<2>(), distance));
       }
     }
   } else {
@@ -46,8 +46,8 @@ int CountOffLine(const std::vector<Eigen::Vector3f>& points, double off_line_dis
       const std::size_t i = pick(rng);
       std::size_t j = pick(rng);
       if (j == i) j = (i + 1) % n;
-      best_on = std::max(best_on,
-                         OnLine(points, points[i].head<2>(), points[j].head<2>(), distance));
+      best_on =
+          std::max(best_on, OnLine(points, points[i].head<2>(), points[j].head<2>(), distance));
     }
   }
   return static_cast<int>(n) - best_on;

@@ -19,8 +19,7 @@ namespace rover::mapping::loop_internal {
 }
 
 /// Finite and lo <= value <= hi.
-inline void CheckRange(const char* component, const char* key, double value, double lo,
-                       double hi) {
+inline void CheckRange(const char* component, const char* key, double value, double lo, double hi) {
   if (!(std::isfinite(value) && value >= lo && value <= hi)) {
     std::ostringstream expected;
     expected << "a finite value in [" << lo << ", " << hi << "]";

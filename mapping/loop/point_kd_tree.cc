@@ -185,7 +185,8 @@ std::vector<std::vector<Neighbour>> DescriptorIndex::Nearest(const Eigen::Matrix
       row.resize(static_cast<std::size_t>(d.rows()));
       for (Eigen::Index j = 0; j < d.rows(); ++j) {
         row[static_cast<std::size_t>(j)] = {
-            std::max(0.0f, q_sq + impl_->norms_sq[j] - 2.0f * dots(i, j)), static_cast<uint32_t>(j)};
+            std::max(0.0f, q_sq + impl_->norms_sq[j] - 2.0f * dots(i, j)),
+            static_cast<uint32_t>(j)};
       }
       std::partial_sort(row.begin(), row.begin() + static_cast<std::ptrdiff_t>(k), row.end());
       auto& out = result[static_cast<std::size_t>(r0 + i)];

@@ -85,8 +85,7 @@ class DescriptorIndex {
   /// For each row of `queries` (same length as the indexed descriptors),
   /// its `k` nearest indexed descriptors, closest first (fewer if the index
   /// is smaller). Throws std::invalid_argument for a length mismatch.
-  std::vector<std::vector<Neighbour>> Nearest(const Eigen::MatrixXf& queries,
-                                              std::size_t k) const;
+  std::vector<std::vector<Neighbour>> Nearest(const Eigen::MatrixXf& queries, std::size_t k) const;
 
  private:
   struct Impl;

@@ -54,8 +54,8 @@ bool FitYawTransform(const std::vector<Eigen::Vector3d>& a, const std::vector<Ei
   return true;
 }
 
-bool FitRigidTransform(const std::vector<Eigen::Vector3d>& a,
-                       const std::vector<Eigen::Vector3d>& b, Eigen::Isometry3d* T_a_b) {
+bool FitRigidTransform(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
+                       Eigen::Isometry3d* T_a_b) {
   if (a.size() != b.size() || a.size() < 3) return false;
   Eigen::Vector3d ca = Eigen::Vector3d::Zero();
   Eigen::Vector3d cb = Eigen::Vector3d::Zero();
@@ -79,8 +79,6 @@ bool FitRigidTransform(const std::vector<Eigen::Vector3d>& a,
   return true;
 }
 
-double TiltOf(const Eigen::Matrix3d& R) {
-  return std::acos(std::clamp(R(2, 2), -1.0, 1.0));
-}
+double TiltOf(const Eigen::Matrix3d& R) { return std::acos(std::clamp(R(2, 2), -1.0, 1.0)); }
 
 }  // namespace rover::mapping

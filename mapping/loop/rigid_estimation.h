@@ -30,8 +30,8 @@ bool FitYawTransform(const std::vector<Eigen::Vector3d>& a, const std::vector<Ei
 
 /// Least squares over the full rotation (SVD of the cross-covariance, with
 /// the reflection fix). Needs >= 3 pairs, not collinear; false otherwise.
-bool FitRigidTransform(const std::vector<Eigen::Vector3d>& a,
-                       const std::vector<Eigen::Vector3d>& b, Eigen::Isometry3d* T_a_b);
+bool FitRigidTransform(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
+                       Eigen::Isometry3d* T_a_b);
 
 /// Roll and pitch of R (R = Rz(yaw) Ry(pitch) Rx(roll)) as the angle
 /// between R's z axis and the vertical, in radians.

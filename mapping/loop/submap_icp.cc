@@ -110,7 +110,8 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
     const Eigen::LDLT<Mat> ldlt(H);
     // A flat patch leaves the translation along it free: no unique step.
     const Eigen::SelfAdjointEigenSolver<Mat> eig(H);
-    if (ldlt.info() != Eigen::Success || eig.eigenvalues()(0) <= 1e-9 * eig.eigenvalues()(Dof - 1)) {
+    if (ldlt.info() != Eigen::Success ||
+        eig.eigenvalues()(0) <= 1e-9 * eig.eigenvalues()(Dof - 1)) {
       return result;
     }
     const Vec delta = -ldlt.solve(g);

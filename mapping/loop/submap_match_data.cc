@@ -27,7 +27,8 @@ class DenseVoxels {
   DenseVoxels(const octomap::OcTree& tree, const octomap::OcTreeKey& lo,
               const octomap::OcTreeKey& hi)
       : lo_(lo) {
-    for (unsigned a = 0; a < 3; ++a) size_[a] = static_cast<int>(hi[a]) - static_cast<int>(lo[a]) + 1;
+    for (unsigned a = 0; a < 3; ++a)
+      size_[a] = static_cast<int>(hi[a]) - static_cast<int>(lo[a]) + 1;
     states_.assign(static_cast<std::size_t>(size_[0] * size_[1] * size_[2]), kUnknown);
     const unsigned max_depth = tree.getTreeDepth();
     for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
@@ -96,7 +97,8 @@ SubmapMatchDataOptions SubmapMatchDataOptions::Load(const ConfigNode& node) {
   o.min_keypoints_off_line = node.Get<int>("min_keypoints_off_line", o.min_keypoints_off_line);
   o.line_samples = node.Get<int>("line_samples", o.line_samples);
   o.icp_voxel_m = node.Get<double>("icp_voxel_m", o.icp_voxel_m);
-  if (node.Has("descriptor")) o.descriptor = GravityDescriptorOptions::Load(node.Child("descriptor"));
+  if (node.Has("descriptor"))
+    o.descriptor = GravityDescriptorOptions::Load(node.Child("descriptor"));
   o.descriptor_search = node.GetEnum<DescriptorSearch>(
       "descriptor_search",
       {{"kdtree", DescriptorSearch::kKdTree}, {"brute_force", DescriptorSearch::kBruteForce}},
@@ -244,11 +246,12 @@ SubmapMatchData::SubmapMatchData(const PointCloud& cloud, const octomap::OcTree&
     icp_normals_.push_back(normals_[n.index]);
   }
 
-  std::vector<Eigen::Vector3f> candidates = VoxelCentroids(obstacle_points, options_.keypoint_voxel_m);
+  std::vector<Eigen::Vector3f> candidates =
+      VoxelCentroids(obstacle_points, options_.keypoint_voxel_m);
   keypoints_before_filter_ = static_cast<int>(candidates.size());
   if (options_.min_known_ratio > 0.0) {
-    const std::vector<float> ratios = KnownRatios(octree, candidates, options_.descriptor.radius_m,
-                                                  options_.solid_below_surface);
+    const std::vector<float> ratios =
+        KnownRatios(octree, candidates, options_.descriptor.radius_m, options_.solid_below_surface);
     std::vector<Eigen::Vector3f> kept;
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       if (static_cast<double>(ratios[i]) >= options_.min_known_ratio) kept.push_back(candidates[i]);
@@ -275,8 +278,8 @@ SubmapMatchData::SubmapMatchData(const PointCloud& cloud, const octomap::OcTree&
   if (keypoints_off_line_ < options_.min_keypoints_off_line) {
     suitability_ = SubmapSuitability::kKeypointsOnALine;
     why << keypoints_off_line_ << " of " << keypoints_.size() << " keypoints farther than "
-        << options_.off_line_distance_m << " m from the best line, expected >= "
-        << options_.min_keypoints_off_line;
+        << options_.off_line_distance_m
+        << " m from the best line, expected >= " << options_.min_keypoints_off_line;
     reason_ = std::string(ToString(suitability_)) + ": " + why.str();
   } else {
     why << pts.size() << " points, " << obstacle_points_ << " obstacle points, "

@@ -39,9 +39,7 @@ std::string Describe(double value, const char* op, double limit) {
 class PriorBounds {
  public:
   PriorBounds(const MatchPrior& prior, const SubmapMatcherOptions& o)
-      : bounded_(prior.bounded),
-        t_(prior.T_a_b.translation()),
-        yaw_(YawOf(prior.T_a_b.linear())) {
+      : bounded_(prior.bounded), t_(prior.T_a_b.translation()), yaw_(YawOf(prior.T_a_b.linear())) {
     for (std::size_t i = 0; i < 3; ++i) {
       const auto e = static_cast<Eigen::Index>(i);
       bound_[i] = std::max(o.prior_sigma_factor * std::sqrt(std::max(0.0, prior.covariance(e, e))),
@@ -59,8 +57,7 @@ class PriorBounds {
     for (std::size_t i = 0; i < 3; ++i) {
       const double di = std::abs(d[static_cast<Eigen::Index>(i)]);
       if (di > bound_[i]) {
-        return std::string("|d") + kAxes[i] + "| " + Describe(di, ">", bound_[i]) +
-               " m";
+        return std::string("|d") + kAxes[i] + "| " + Describe(di, ">", bound_[i]) + " m";
       }
     }
     const double dyaw = std::abs(WrapAngle(YawOf(T.linear()) - yaw_));
@@ -115,9 +112,9 @@ using BinKey = std::array<int, 3>;
 // model's keypoint centroid lies in the scene, through the yaw references
 // of its two keypoints. Returns clusters of correspondence indices.
 std::vector<std::vector<std::size_t>> HoughClusters(const std::vector<KeypointMatch>& matches,
-                                            const SubmapMatchData& model,
-                                            const SubmapMatchData& scene, bool model_is_a,
-                                            const SubmapMatcherOptions& o) {
+                                                    const SubmapMatchData& model,
+                                                    const SubmapMatchData& scene, bool model_is_a,
+                                                    const SubmapMatcherOptions& o) {
   const std::vector<Eigen::Vector3f>& mk = model.keypoints();
   const std::vector<Eigen::Vector3f>& sk = scene.keypoints();
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -204,10 +201,10 @@ int CountInliers(const Eigen::Isometry3d& T, const std::vector<KeypointMatch>& m
 
 // The best hypothesis of one cluster, refit on its inliers; nullopt-like
 // (inliers == 0) if none survived.
-Hypothesis RansacCluster(const std::vector<std::size_t>& cluster, const std::vector<KeypointMatch>& matches,
-                         const SubmapMatchData& a, const SubmapMatchData& b,
-                         const PriorBounds& bounds, const SubmapMatcherOptions& o,
-                         std::mt19937_64* rng, int* hypotheses) {
+Hypothesis RansacCluster(const std::vector<std::size_t>& cluster,
+                         const std::vector<KeypointMatch>& matches, const SubmapMatchData& a,
+                         const SubmapMatchData& b, const PriorBounds& bounds,
+                         const SubmapMatcherOptions& o, std::mt19937_64* rng, int* hypotheses) {
   Hypothesis best;
   best.cluster_size = static_cast<int>(cluster.size());
   const bool four = o.mode == MatchMode::kFourDof;
@@ -376,10 +373,10 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
   d("min_bound_yaw_rad", &o.min_bound_yaw_rad);
   if (node.Has("icp")) {
     const ConfigNode icp = node.Child("icp");
-    o.icp.metric = icp.GetEnum<IcpMetric>(
-        "metric",
-        {{"point_to_plane", IcpMetric::kPointToPlane}, {"point_to_point", IcpMetric::kPointToPoint}},
-        o.icp.metric);
+    o.icp.metric = icp.GetEnum<IcpMetric>("metric",
+                                          {{"point_to_plane", IcpMetric::kPointToPlane},
+                                           {"point_to_point", IcpMetric::kPointToPoint}},
+                                          o.icp.metric);
     o.icp.max_iterations = icp.Get<int>("max_iterations", o.icp.max_iterations);
     o.icp.initial_distance_m = icp.Get<double>("initial_distance_m", o.icp.initial_distance_m);
     o.icp.final_distance_m = icp.Get<double>("final_distance_m", o.icp.final_distance_m);
@@ -422,11 +419,10 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   if (!a.suitable()) return finish("submap a unsuitable: " + a.suitability_reason());
   if (!b.suitable()) return finish("submap b unsuitable: " + b.suitability_reason());
   if (a.descriptors().descriptors().cols() != b.descriptors().descriptors().cols()) {
-    throw std::invalid_argument(
-        "SubmapMatcher::Match: descriptor lengths differ (a: " +
-        std::to_string(a.descriptors().descriptors().cols()) +
-        ", b: " + std::to_string(b.descriptors().descriptors().cols()) +
-        "); build both with the same descriptor options");
+    throw std::invalid_argument("SubmapMatcher::Match: descriptor lengths differ (a: " +
+                                std::to_string(a.descriptors().descriptors().cols()) +
+                                ", b: " + std::to_string(b.descriptors().descriptors().cols()) +
+                                "); build both with the same descriptor options");
   }
 
   // 1. Correspondences.
@@ -444,8 +440,8 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   for (auto& c : HoughClusters(r.correspondences, b, a, false, o)) clusters.push_back(std::move(c));
   r.clusters = static_cast<int>(clusters.size());
   r.timings.hough_ms = MsSince(ts);
-  if (clusters.empty()) return finish("no Hough cluster with >= " +
-                                      std::to_string(o.min_cluster_votes) + " votes");
+  if (clusters.empty())
+    return finish("no Hough cluster with >= " + std::to_string(o.min_cluster_votes) + " votes");
 
   // 3. RANSAC per cluster; the best by inliers among those spread beyond a
   // line on both sides.

@@ -148,7 +148,7 @@ struct SubmapMatchResult {
   std::vector<KeypointMatch> correspondences;
   std::vector<KeypointMatch> inliers;
   int clusters = 0;
-  int hypotheses = 0;  ///< RANSAC hypotheses inside the prior's bounds
+  int hypotheses = 0;         ///< RANSAC hypotheses inside the prior's bounds
   double inlier_ratio = 0.0;  ///< inliers / correspondences of the winning cluster
   /// The RANSAC winner before refinement.
   Eigen::Isometry3d T_a_b_initial = Eigen::Isometry3d::Identity();

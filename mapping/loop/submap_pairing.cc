@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/geometry/so3.h"
 #include "mapping/loop/option_checks.h"
@@ -174,9 +174,9 @@ SubmapPair SubmapPairing::Evaluate(const SubmapId& a, const SubmapId& b) const {
 
   const auto given = relative_.find(Ordered(a, b));
   if (given != relative_.end()) {
-    const Matrix6d cov = given->second.frame == a
-                             ? given->second.covariance
-                             : InverseCovariance(pair.prior.T_a_b.inverse(), given->second.covariance);
+    const Matrix6d cov = given->second.frame == a ? given->second.covariance
+                                                  : InverseCovariance(pair.prior.T_a_b.inverse(),
+                                                                      given->second.covariance);
     pair.prior.covariance = cov;
     const Eigen::Matrix3d world = R_world_a * cov.topLeftCorner<3, 3>() * R_world_a.transpose();
     pair.relative_sigma_m = world.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -191,8 +191,7 @@ SubmapPair SubmapPairing::Evaluate(const SubmapId& a, const SubmapId& b) const {
     }
     pair.relative_sigma_m = var.head<3>().cwiseSqrt();
     Matrix6d cov = Matrix6d::Zero();
-    cov.topLeftCorner<3, 3>() =
-        R_world_a.transpose() * var.head<3>().asDiagonal() * R_world_a;
+    cov.topLeftCorner<3, 3>() = R_world_a.transpose() * var.head<3>().asDiagonal() * R_world_a;
     cov.bottomRightCorner<3, 3>() = var.tail<3>().asDiagonal();
     pair.prior.covariance = cov;
   }
