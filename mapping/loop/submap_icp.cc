@@ -55,6 +55,8 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
   SubmapIcpResult result;
   result.T_a_b = initial;
   const std::vector<Eigen::Vector3f>& source = b.icp_points();
+  const std::vector<Eigen::Vector3f>& source_normals = b.icp_normals();
+  const double min_normal_dot = std::cos(o.max_normal_angle_deg * M_PI / 180.0);
   const std::vector<Eigen::Vector3f>& target = a.cloud().points();
   const std::vector<Eigen::Vector3f>& target_normals = a.normals();
   if (source.empty() || target.empty()) return result;
@@ -80,12 +82,16 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
     considered = 0;
     const Eigen::Isometry3d T = result.T_a_b;
     const auto reach = static_cast<float>(max_distance);
-    for (const Eigen::Vector3f& pb : source) {
-      const Eigen::Vector3d q = T * pb.cast<double>();
+    for (std::size_t j = 0; j < source.size(); ++j) {
+      const Eigen::Vector3d q = T * source[j].cast<double>();
       if (box.exteriorDistance(q) > max_distance) continue;
       ++considered;
       Neighbour n;
       if (!a.cloud().Nearest(q.cast<float>(), reach, &n)) continue;
+      if ((T.linear() * source_normals[j].cast<double>())
+              .dot(target_normals[n.index].cast<double>()) < min_normal_dot) {
+        continue;
+      }
       ++matched;
       const Eigen::Vector3d p = target[n.index].cast<double>();
       const Eigen::Matrix<double, 3, Dof> Jq = PointJacobian<Dof>(q);
@@ -126,6 +132,16 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
   }
 
   result.ok = true;
+  const auto agree = static_cast<float>(o.obstacle_agreement_distance_m);
+  for (std::size_t j = 0; j < source.size(); ++j) {
+    if (!b.icp_obstacle()[j]) continue;
+    Neighbour n;
+    if (!a.cloud().Nearest((result.T_a_b * source[j].cast<double>()).cast<float>(), agree, &n)) {
+      continue;
+    }
+    ++result.obstacle_points_near;
+    result.obstacle_points_agreeing += a.obstacle()[n.index] != 0;
+  }
   result.correspondences = matched;
   result.overlap_points = matched;
   result.source_points = considered;
@@ -164,6 +180,8 @@ void SubmapIcpOptions::Validate() const {
   CheckPositive(kC, "convergence_m", convergence_m);
   CheckPositive(kC, "convergence_rad", convergence_rad);
   CheckRange(kC, "min_correspondences", min_correspondences, 10, 1e9);
+  CheckRange(kC, "max_normal_angle_deg", max_normal_angle_deg, 0.0, 180.0);
+  CheckPositive(kC, "obstacle_agreement_distance_m", obstacle_agreement_distance_m);
 }
 
 SubmapIcpResult AlignSubmaps(const SubmapMatchData& a, const SubmapMatchData& b,

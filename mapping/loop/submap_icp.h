@@ -36,10 +36,17 @@ struct SubmapIcpOptions {
   double final_distance_m = 0.15;
   /// Converged when a step moves less than this (translation, and rotation
   /// in rad) once the distance has reached final_distance_m.
-  double convergence_m = 1e-4;
-  double convergence_rad = 1e-5;
+  double convergence_m = 1e-3;
+  double convergence_rad = 1e-4;
   /// Fewer correspondences than this: the ICP fails.
   int min_correspondences = 100;
+  /// A pair whose normals (both pointing to their free side) differ by more
+  /// than this is not a correspondence: a rock's front against its back.
+  /// 180 deg disables the test.
+  double max_normal_angle_deg = 60.0;
+  /// Obstacle agreement at the result: b's obstacle points with an a point
+  /// within this distance, and how many of those a point is an obstacle.
+  double obstacle_agreement_distance_m = 0.15;
 
   /// Throws std::invalid_argument "SubmapIcpOptions.<key>: ...".
   void Validate() const;
@@ -64,6 +71,11 @@ struct SubmapIcpResult {
   /// points considered (those within the target's box).
   int overlap_points = 0;
   int source_points = 0;
+  /// b's obstacle points (ICP subsample) with an a point nearby at the
+  /// result, and of those the ones whose nearest a point is an obstacle
+  /// too: a false alignment lays rocks on ground.
+  int obstacle_points_near = 0;
+  int obstacle_points_agreeing = 0;
 };
 
 /// Refines T_a_b from `initial`. `four_dof` selects x, y, z, yaw only.

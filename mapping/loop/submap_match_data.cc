@@ -53,6 +53,16 @@ class DenseVoxels {
   }
 
   uint8_t At(int x, int y, int z) const { return states_[Index(x, y, z)]; }
+  /// State at a key, unknown outside the box.
+  uint8_t AtKey(const octomap::OcTreeKey& k) const {
+    const int x = static_cast<int>(k[0]) - static_cast<int>(lo_[0]);
+    const int y = static_cast<int>(k[1]) - static_cast<int>(lo_[1]);
+    const int z = static_cast<int>(k[2]) - static_cast<int>(lo_[2]);
+    if (x < 0 || y < 0 || z < 0 || x >= size_[0] || y >= size_[1] || z >= size_[2]) {
+      return kUnknown;
+    }
+    return At(x, y, z);
+  }
   const int* size() const { return size_; }
   const octomap::OcTreeKey& lo() const { return lo_; }
 
@@ -91,6 +101,8 @@ SubmapMatchDataOptions SubmapMatchDataOptions::Load(const ConfigNode& node) {
   o.min_known_ratio = node.Get<double>("min_known_ratio", o.min_known_ratio);
   o.solid_below_surface = node.Get<bool>("solid_below_surface", o.solid_below_surface);
   o.normal_radius_m = node.Get<double>("normal_radius_m", o.normal_radius_m);
+  o.orient_normals_to_free_space =
+      node.Get<bool>("orient_normals_to_free_space", o.orient_normals_to_free_space);
   o.min_points = node.Get<int>("min_points", o.min_points);
   o.min_obstacle_points = node.Get<int>("min_obstacle_points", o.min_obstacle_points);
   o.off_line_distance_m = node.Get<double>("off_line_distance_m", o.off_line_distance_m);
@@ -140,6 +152,30 @@ std::vector<Eigen::Vector3f> VoxelCentroids(const std::vector<Eigen::Vector3f>& 
   out.reserve(voxels.size());
   for (const auto& [key, v] : voxels) out.push_back((v.first / v.second).cast<float>());
   return out;
+}
+
+void OrientNormalsToFreeSpace(const octomap::OcTree& octree,
+                              const std::vector<Eigen::Vector3f>& points,
+                              std::vector<Eigen::Vector3f>* normals) {
+  if (points.empty()) return;
+  const auto step = static_cast<float>(octree.getResolution());
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : points) box.extend(p);
+  octomap::OcTreeKey lo, hi;
+  const Eigen::Vector3f min = box.min().array() - 2.0f * step;
+  const Eigen::Vector3f max = box.max().array() + 2.0f * step;
+  if (!octree.coordToKeyChecked(min.x(), min.y(), min.z(), lo) ||
+      !octree.coordToKeyChecked(max.x(), max.y(), max.z(), hi)) {
+    return;  // beyond the key range: keep the gravity orientation
+  }
+  const DenseVoxels voxels(octree, lo, hi);
+  const auto state = [&](const Eigen::Vector3f& p) {
+    return voxels.AtKey(octree.coordToKey(p.x(), p.y(), p.z()));
+  };
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    Eigen::Vector3f& n = (*normals)[i];
+    if (state(points[i] + step * n) != kFree && state(points[i] - step * n) == kFree) n = -n;
+  }
 }
 
 std::vector<float> KnownRatios(const octomap::OcTree& octree,
@@ -238,12 +274,14 @@ SubmapMatchData::SubmapMatchData(const PointCloud& cloud, const octomap::OcTree&
   }
 
   normals_ = ComputeSurfaceNormals(cloud_, static_cast<float>(options_.normal_radius_m));
+  if (options_.orient_normals_to_free_space) OrientNormalsToFreeSpace(octree, pts, &normals_);
   icp_points_ = VoxelCentroids(pts, options_.icp_voxel_m);
   icp_normals_.reserve(icp_points_.size());
   for (const Eigen::Vector3f& p : icp_points_) {
     Neighbour n;
     cloud_.Nearest(p, static_cast<float>(options_.icp_voxel_m), &n);
     icp_normals_.push_back(normals_[n.index]);
+    icp_obstacle_.push_back(obstacle_[n.index]);
   }
 
   std::vector<Eigen::Vector3f> candidates =

@@ -19,6 +19,13 @@
 //              0.5 m in xy from the best-fitting line), else the submap is
 //              never paired.
 //
+// Normals point to the observed side: PCA leaves their sign open, and
+// gravity alone (n_z >= 0) cannot tell the front of a rock from its back.
+// The voxel space can: the side a camera looked from is free. A normal whose
+// tip lies in unknown or occupied space while its tail lies in free space is
+// flipped. The ICP then refuses to pair a rock's front seen from one submap
+// with its back seen from the other (opposite-direction revisits).
+//
 // Unknown space below the surface: stereo never sees under the ground, so
 // half of the sphere around a ground-level keypoint is unknown however well
 // the place was seen. That is not unknown space the descriptor could mistake
@@ -51,6 +58,8 @@ struct SubmapMatchDataOptions {
   bool solid_below_surface = true;
   /// Neighbourhood of the PCA normals.
   double normal_radius_m = 0.15;
+  /// Flip normals towards the free side (see above); off: all point up.
+  bool orient_normals_to_free_space = true;
   /// Suitability (thesis section 6.1.1).
   int min_points = 1000;
   int min_obstacle_points = 100;
@@ -110,13 +119,15 @@ class SubmapMatchData {
   const std::vector<float>& yaw_reference_rad() const { return yaw_reference_rad_; }
   const std::vector<float>& yaw_reference_strength() const { return yaw_reference_strength_; }
 
-  /// The full cloud, its normals (n_z >= 0) and obstacle flags.
+  /// The full cloud, its normals (towards free space) and obstacle flags.
   const PointKdTree& cloud() const { return cloud_; }
   const std::vector<Eigen::Vector3f>& normals() const { return normals_; }
   const std::vector<uint8_t>& obstacle() const { return obstacle_; }
-  /// The cloud through icp_voxel_m (centroids), with normals.
+  /// The cloud through icp_voxel_m (centroids), with the normal and the
+  /// obstacle flag of the nearest cloud point.
   const std::vector<Eigen::Vector3f>& icp_points() const { return icp_points_; }
   const std::vector<Eigen::Vector3f>& icp_normals() const { return icp_normals_; }
+  const std::vector<uint8_t>& icp_obstacle() const { return icp_obstacle_; }
 
   /// Axis-aligned xy box of the obstacle points (submap frame); empty if
   /// there are none.
@@ -148,6 +159,7 @@ class SubmapMatchData {
   std::vector<uint8_t> obstacle_;
   std::vector<Eigen::Vector3f> icp_points_;
   std::vector<Eigen::Vector3f> icp_normals_;
+  std::vector<uint8_t> icp_obstacle_;
   Eigen::AlignedBox2d obstacle_box_xy_;
   int obstacle_points_ = 0;
   int keypoints_before_filter_ = 0;
@@ -161,6 +173,13 @@ class SubmapMatchData {
 /// index, so the result does not depend on the input order).
 std::vector<Eigen::Vector3f> VoxelCentroids(const std::vector<Eigen::Vector3f>& points,
                                             double voxel_m);
+
+/// Flips each normal whose tip (point + one voxel along it) is not free in
+/// `octree` while its tail (point - one voxel) is; `normals` and `points`
+/// correspond.
+void OrientNormalsToFreeSpace(const octomap::OcTree& octree,
+                              const std::vector<Eigen::Vector3f>& points,
+                              std::vector<Eigen::Vector3f>* normals);
 
 /// Share of known voxels of `octree` among those whose centres lie within
 /// `radius_m` of each query point, with unknown voxels under an occupied one

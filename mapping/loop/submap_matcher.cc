@@ -220,6 +220,8 @@ Hypothesis RansacCluster(const std::vector<std::size_t>& cluster,
     return std::abs((pa(c1) - pa(c2)).norm() - (pb(c1) - pb(c2)).norm()) <= tolerance;
   };
   std::uniform_int_distribution<std::size_t> pick(0, cluster.size() - 1);
+  const double inlier_sq = o.inlier_distance_m * o.inlier_distance_m;
+  int best_support = 0;
   for (int it = 0; it < o.ransac_iterations; ++it) {
     std::size_t s[3] = {0, 0, 0};
     for (std::size_t k = 0; k < sample_size; ++k) s[k] = cluster[pick(*rng)];
@@ -239,13 +241,17 @@ Hypothesis RansacCluster(const std::vector<std::size_t>& cluster,
     }
     if (!bounds.Inside(T)) continue;
     ++*hypotheses;
-    const int inliers = CountInliers(T, matches, a, b, o.inlier_distance_m, nullptr);
-    if (inliers > best.inliers) {
-      best.inliers = inliers;
+    // Scored on the cluster's own correspondences (cheap); the winner's
+    // inliers are counted over all of them below.
+    int support = 0;
+    for (std::size_t c : cluster) support += (pa(c) - T * pb(c)).squaredNorm() <= inlier_sq;
+    if (support > best_support) {
+      best_support = support;
       best.T_a_b = T;
     }
   }
-  if (best.inliers == 0) return best;
+  if (best_support == 0) return best;
+  best.inliers = CountInliers(best.T_a_b, matches, a, b, o.inlier_distance_m, nullptr);
   // Least-squares refit on the inliers, kept if it stays within bounds and
   // does not lose inliers.
   CountInliers(best.T_a_b, matches, a, b, o.inlier_distance_m, &best.inlier_matches);
@@ -341,6 +347,8 @@ void SubmapMatcherOptions::Validate() const {
   CheckRange(kC, "min_inlier_ratio", min_inlier_ratio, 0.0, 1.0);
   CheckPositive(kC, "max_icp_rmse_m", max_icp_rmse_m);
   CheckRange(kC, "min_overlap_ratio", min_overlap_ratio, 0.0, 1.0);
+  CheckRange(kC, "min_obstacle_agreement", min_obstacle_agreement, 0.0, 1.0);
+  CheckRange(kC, "min_obstacle_points_near", min_obstacle_points_near, 0, 1e9);
   CheckPositive(kC, "max_icp_shift_m", max_icp_shift_m);
   CheckPositive(kC, "max_icp_turn_rad", max_icp_turn_rad);
   CheckRange(kC, "max_final_tilt_rad", max_final_tilt_rad, 0.0, M_PI);
@@ -383,11 +391,17 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
     o.icp.convergence_m = icp.Get<double>("convergence_m", o.icp.convergence_m);
     o.icp.convergence_rad = icp.Get<double>("convergence_rad", o.icp.convergence_rad);
     o.icp.min_correspondences = icp.Get<int>("min_correspondences", o.icp.min_correspondences);
+    o.icp.max_normal_angle_deg =
+        icp.Get<double>("max_normal_angle_deg", o.icp.max_normal_angle_deg);
+    o.icp.obstacle_agreement_distance_m =
+        icp.Get<double>("obstacle_agreement_distance_m", o.icp.obstacle_agreement_distance_m);
   }
   i("min_inliers", &o.min_inliers);
   d("min_inlier_ratio", &o.min_inlier_ratio);
   d("max_icp_rmse_m", &o.max_icp_rmse_m);
   d("min_overlap_ratio", &o.min_overlap_ratio);
+  d("min_obstacle_agreement", &o.min_obstacle_agreement);
+  i("min_obstacle_points_near", &o.min_obstacle_points_near);
   d("max_icp_shift_m", &o.max_icp_shift_m);
   d("max_icp_turn_rad", &o.max_icp_turn_rad);
   d("max_final_tilt_rad", &o.max_final_tilt_rad);
@@ -506,6 +520,18 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   }
   if (r.overlap_ratio < o.min_overlap_ratio) {
     return finish("overlap " + Describe(r.overlap_ratio, "<", o.min_overlap_ratio));
+  }
+  r.obstacle_agreement =
+      r.icp.obstacle_points_near > 0
+          ? static_cast<double>(r.icp.obstacle_points_agreeing) / r.icp.obstacle_points_near
+          : 0.0;
+  if (r.icp.obstacle_points_near < o.min_obstacle_points_near) {
+    return finish("obstacle points near a " +
+                  Describe(r.icp.obstacle_points_near, "<", o.min_obstacle_points_near));
+  }
+  if (r.obstacle_agreement < o.min_obstacle_agreement) {
+    return finish("obstacle agreement " +
+                  Describe(r.obstacle_agreement, "<", o.min_obstacle_agreement));
   }
   const std::string outside = bounds.Violation(r.T_a_b);
   if (!outside.empty()) return finish("final transform outside the prior's bounds: " + outside);

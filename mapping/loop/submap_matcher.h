@@ -13,14 +13,17 @@
 //   3. RANSAC per cluster. 4D (the thesis's method): two-point hypotheses
 //      over x, y, z, yaw (eq. 6.5-6.7). 6D (the baseline, options.mode =
 //      kSixDof): three-point SVD hypotheses, tilt > 10 deg dropped.
-//      Hypotheses outside the prior's k-sigma bounds are dropped; inliers
-//      are counted over all correspondences (unique keypoints on both
-//      sides); a hypothesis whose inlier keypoints lie along a line
-//      (line_spread.h) is dropped. The best one by inliers wins.
+//      Hypotheses outside the prior's k-sigma bounds are dropped; each is
+//      scored on its cluster, the cluster's best is refit on its inliers
+//      counted over all correspondences (unique keypoints on both sides,
+//      so one keypoint matched to three neighbours counts once); one whose
+//      inlier keypoints lie along a line (line_spread.h) is dropped. The
+//      best one by inliers wins.
 //   4. ICP on the full clouds (submap_icp.h), 4D or 6D.
 //   5. Validity: RANSAC inliers and inlier ratio, ICP residual, overlap,
-//      the final transform within the prior's bounds, and in 6D tilt
-//      <= 1 deg.
+//      obstacle agreement (b's obstacles must land on a's obstacles, not on
+//      a's ground: flat ground aligns anywhere, rocks do not), the final
+//      transform within the prior's bounds, and in 6D tilt <= 1 deg.
 // A Match() call keeps no state: it is const and may run concurrently on
 // any number of threads; its randomness is seeded from options.seed only,
 // so equal inputs give equal results.
@@ -97,10 +100,15 @@ struct SubmapMatcherOptions {
   double min_inlier_ratio = 0.05;
   double max_icp_rmse_m = 0.08;
   double min_overlap_ratio = 0.25;
+  /// Of b's obstacle points that land near a's cloud, the share landing on
+  /// a's obstacles (SubmapIcpResult::obstacle_points_agreeing), and the
+  /// least number of them.
+  double min_obstacle_agreement = 0.5;
+  int min_obstacle_points_near = 20;
   /// ICP must not move further than this from the RANSAC hypothesis (a jump
   /// means it fell into another basin).
-  double max_icp_shift_m = 0.5;
-  double max_icp_turn_rad = 5.0 * M_PI / 180.0;
+  double max_icp_shift_m = 1.0;
+  double max_icp_turn_rad = 10.0 * M_PI / 180.0;
   /// 6D: tilt after the ICP at most this (thesis: 1 deg).
   double max_final_tilt_rad = 1.0 * M_PI / 180.0;
   /// Covariance of an accepted match: the ICP's s^2 H^-1 scaled by
@@ -155,6 +163,8 @@ struct SubmapMatchResult {
   SubmapIcpResult icp;
   /// Share of the smaller ICP subsample that found a partner.
   double overlap_ratio = 0.0;
+  /// obstacle_points_agreeing / obstacle_points_near of the ICP result.
+  double obstacle_agreement = 0.0;
   MatchTimings timings;
 };
 

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <random>
@@ -141,7 +142,7 @@ inline Hit CastRay(const Eigen::Vector3d& c, const Eigen::Vector3d& d, const Loo
 
 struct RenderSettings {
   int head_factor = 2;  ///< SimulatorHead(2): 376x240
-  double disparity_noise_px = 0.25;
+  double disparity_noise_px = std::getenv("NOISE") ? std::atof(std::getenv("NOISE")) : 0.25;
   double stereo_range_m = 7.0;
   double max_depth_sigma_m = 0.3;
 };
