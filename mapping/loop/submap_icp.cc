@@ -18,6 +18,11 @@ using loop_internal::CheckRange;
 
 constexpr double kDistanceShrink = 0.7;
 
+// Cauchy weight of a squared residual; 1 without a scale.
+double Weight(double r_sq, double scale_m) {
+  return scale_m > 0.0 ? 1.0 / (1.0 + r_sq / (scale_m * scale_m)) : 1.0;
+}
+
 // d q / d delta for the left perturbation: [I, z x q] (4D) or [I, -[q]x].
 template <int Dof>
 Eigen::Matrix<double, 3, Dof> PointJacobian(const Eigen::Vector3d& q) {
@@ -100,15 +105,17 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
         const Eigen::Vector3d normal = target_normals[n.index].cast<double>();
         const double r = normal.dot(q - p);
         const Eigen::Matrix<double, 1, Dof> J = normal.transpose() * Jq;
-        H.noalias() += J.transpose() * J;
-        g.noalias() += J.transpose() * r;
-        sum_sq += r * r;
+        const double w = Weight(r * r, o.robust_scale_m);
+        H.noalias() += w * J.transpose() * J;
+        g.noalias() += w * J.transpose() * r;
+        sum_sq += w * r * r;
         ++residuals;
       } else {
         const Eigen::Vector3d r = q - p;
-        H.noalias() += Jq.transpose() * Jq;
-        g.noalias() += Jq.transpose() * r;
-        sum_sq += r.squaredNorm();
+        const double w = Weight(r.squaredNorm(), o.robust_scale_m);
+        H.noalias() += w * Jq.transpose() * Jq;
+        g.noalias() += w * Jq.transpose() * r;
+        sum_sq += w * r.squaredNorm();
         residuals += 3;
       }
     }
@@ -181,6 +188,7 @@ void SubmapIcpOptions::Validate() const {
   CheckPositive(kC, "convergence_rad", convergence_rad);
   CheckRange(kC, "min_correspondences", min_correspondences, 10, 1e9);
   CheckRange(kC, "max_normal_angle_deg", max_normal_angle_deg, 0.0, 180.0);
+  CheckRange(kC, "robust_scale_m", robust_scale_m, 0.0, 100.0);
   CheckPositive(kC, "obstacle_agreement_distance_m", obstacle_agreement_distance_m);
 }
 

@@ -38,6 +38,10 @@ struct SubmapIcpOptions {
   /// in rad) once the distance has reached final_distance_m.
   double convergence_m = 1e-3;
   double convergence_rad = 1e-4;
+  /// Cauchy weights w = 1 / (1 + (r / c)^2) on the residuals (iteratively
+  /// reweighted), c = robust_scale_m; 0: plain least squares within the
+  /// correspondence distance.
+  double robust_scale_m = 0.0;
   /// Fewer correspondences than this: the ICP fails.
   int min_correspondences = 100;
   /// A pair whose normals (both pointing to their free side) differ by more

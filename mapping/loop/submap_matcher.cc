@@ -302,8 +302,10 @@ Matrix6d MatchCovariance(const SubmapIcpResult& icp, const SubmapMatcherOptions&
     cov(3, 3) = rp2;
     cov(4, 4) = rp2;
   }
-  const double floors[6] = {o.min_sigma_m,          o.min_sigma_m,          o.min_sigma_m,
-                            o.roll_pitch_sigma_rad, o.roll_pitch_sigma_rad, o.min_sigma_yaw_rad};
+  const double sigma_m = std::max(o.min_sigma_m, o.rmse_sigma_factor * icp.rmse_m);
+  const double floors[6] = {sigma_m,  sigma_m,
+                            sigma_m,  o.roll_pitch_sigma_rad,
+                            o.roll_pitch_sigma_rad, o.min_sigma_yaw_rad};
   for (int i = 0; i < 6; ++i) {
     const double f2 = floors[i] * floors[i];
     if (cov(i, i) < f2) cov(i, i) = f2;
@@ -354,6 +356,7 @@ void SubmapMatcherOptions::Validate() const {
   CheckRange(kC, "max_final_tilt_rad", max_final_tilt_rad, 0.0, M_PI);
   CheckPositive(kC, "covariance_scale", covariance_scale);
   CheckPositive(kC, "min_sigma_m", min_sigma_m);
+  CheckRange(kC, "rmse_sigma_factor", rmse_sigma_factor, 0.0, 1e3);
   CheckPositive(kC, "min_sigma_yaw_rad", min_sigma_yaw_rad);
   CheckPositive(kC, "roll_pitch_sigma_rad", roll_pitch_sigma_rad);
 }
@@ -407,6 +410,7 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
   d("max_final_tilt_rad", &o.max_final_tilt_rad);
   d("covariance_scale", &o.covariance_scale);
   d("min_sigma_m", &o.min_sigma_m);
+  d("rmse_sigma_factor", &o.rmse_sigma_factor);
   d("min_sigma_yaw_rad", &o.min_sigma_yaw_rad);
   d("roll_pitch_sigma_rad", &o.roll_pitch_sigma_rad);
   o.seed = node.Get<uint64_t>("seed", o.seed);

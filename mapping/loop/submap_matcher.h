@@ -114,10 +114,17 @@ struct SubmapMatcherOptions {
   /// Covariance of an accepted match: the ICP's s^2 H^-1 scaled by
   /// covariance_scale, each standard deviation floored, roll and pitch (4D)
   /// given roll_pitch_sigma_rad: the origins are gravity-aligned up to the
-  /// filter's tilt error.
+  /// filter's tilt error. s^2 H^-1 treats thousands of neighbouring stereo
+  /// points as independent and misses the systematic part (each submap sees
+  /// other sides of the rocks), so it is far too small on its own; the
+  /// translation floor is the larger of min_sigma_m and rmse_sigma_factor
+  /// times the ICP's RMSE (the thesis derives the uncertainty from the
+  /// RMSE), so that noisier matches weigh less. rover-sim loop measures the
+  /// consistency of the result against ground truth.
   double covariance_scale = 1.0;
-  double min_sigma_m = 0.03;
-  double min_sigma_yaw_rad = 0.3 * M_PI / 180.0;
+  double min_sigma_m = 0.04;
+  double rmse_sigma_factor = 2.5;
+  double min_sigma_yaw_rad = 0.4 * M_PI / 180.0;
   double roll_pitch_sigma_rad = 0.005;
   uint64_t seed = 1;
 

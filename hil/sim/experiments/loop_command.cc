@@ -472,6 +472,27 @@ Subcommand AddLoopCommand(CLI::App& app) {
   cmd->add_option("--cache-dir", options->cache_dir,
                   "keep built submaps here and reuse them (same scenario, seed, planning)");
   cmd->add_option("--min-known-ratio", options->data.min_known_ratio)->capture_default_str();
+  cmd->add_option("--max-normal-angle-deg", options->matcher.icp.max_normal_angle_deg,
+                  "ICP normal compatibility, 180: off")
+      ->capture_default_str();
+  cmd->add_flag(
+      "--gravity-normals",
+      [options](int64_t) { options->data.orient_normals_to_free_space = false; },
+      "all normals up instead of towards the voxel space's free side");
+  cmd->add_flag(
+      "--no-6d", [options](int64_t) { options->six_dof_baseline = false; },
+      "skip the 6D baseline");
+  cmd->add_option("--icp-robust-scale-m", options->matcher.icp.robust_scale_m)
+      ->capture_default_str();
+  cmd->add_option("--icp-final-distance-m", options->matcher.icp.final_distance_m)
+      ->capture_default_str();
+  cmd->add_option("--icp-voxel-m", options->data.icp_voxel_m)->capture_default_str();
+  cmd->add_option("--min-obstacle-agreement", options->matcher.min_obstacle_agreement)
+      ->capture_default_str();
+  cmd->add_option("--min-sigma-m", options->matcher.min_sigma_m)->capture_default_str();
+  cmd->add_option("--rmse-sigma-factor", options->matcher.rmse_sigma_factor)
+      ->capture_default_str();
+  cmd->add_option("--min-sigma-yaw-rad", options->matcher.min_sigma_yaw_rad)->capture_default_str();
   return {cmd, [options] { return RunLoop(*options, std::cout, std::cerr); }};
 }
 
