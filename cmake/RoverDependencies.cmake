@@ -18,6 +18,8 @@ if(NOT ROVER_FUZZ)
   find_package(Ceres 2.1 REQUIRED)
   # Submap voxels and the composed global map (mapping/submap, mapping/compose).
   find_package(octomap 1.9 REQUIRED)
+  # k-d trees of the submap matcher (mapping/loop), header only.
+  find_package(nanoflann 1.4 REQUIRED)
   # Log service (firmware/runtime/log_service) and rover-log list/download:
   # cpp-httplib is a compiled library on Debian (its pkg-config flags select
   # the OpenSSL/zlib/brotli build it was compiled with); SHA-256 via libcrypto.

@@ -39,6 +39,7 @@ DEBIAN_PACKAGES=(
   libegl-mesa0               # Mesa's EGL driver (surfaceless platform, no display needed)
   libgl1-mesa-dri            # Mesa's llvmpipe software rasteriser: renders without a GPU
   liboctomap-dev             # submap voxels and the global map (mapping/submap, mapping/compose): .bt/.ot
+  libnanoflann-dev           # k-d trees of the submap matcher (mapping/loop): keypoints, descriptors, ICP
   libceres-dev               # pose-graph back end (mapping/graph, rover-graph): Manifold API, sparse Cholesky
   libsuitesparse-dev         # CHOLMOD (mapping/graph): sparse LL^T of the SE-Sync Newton solver and the certificate's definiteness test
   rt-tests                   # cyclictest: reference wake-up latency for scripts/rt_latency.sh

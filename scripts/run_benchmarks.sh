@@ -29,6 +29,7 @@ echo
 echo "== Mapping: fast octree insertion vs insertPointCloud, SGBM at 752x480"
 "$build/bench/mapping/bench_octree_insertion"
 "$build/bench/mapping/bench_sgbm"
+"$build/bench/mapping/bench_loop_match"
 echo
 echo "== Drivers: Xbus (Xsens MTi) decoding"
 "$build/bench/drivers/bench_xbus_decode"

@@ -15,6 +15,7 @@
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/devices/simulated_mti.h"
 #include "hil/sim/experiments/filter_command.h"
+#include "hil/sim/experiments/loop_command.h"
 #include "hil/sim/experiments/map_command.h"
 #include "hil/sim/experiments/nees_command.h"
 #include "hil/sim/imu_mission.h"
@@ -293,6 +294,7 @@ int main(int argc, char** argv) {
       experiments::AddFilterCommand(app),
       experiments::AddNeesCommand(app),
       experiments::AddMapCommand(app),
+      experiments::AddLoopCommand(app),
   };
 
   CLI11_PARSE(app, argc, argv);
