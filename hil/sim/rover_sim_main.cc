@@ -17,6 +17,7 @@
 #include "hil/sim/experiments/filter_command.h"
 #include "hil/sim/experiments/map_command.h"
 #include "hil/sim/experiments/nees_command.h"
+#include "hil/sim/experiments/terrain_command.h"
 #include "hil/sim/imu_mission.h"
 #include "hil/sim/live/sim_can_bus.h"
 #include "hil/sim/scenario/scenario.h"
@@ -293,6 +294,7 @@ int main(int argc, char** argv) {
       experiments::AddFilterCommand(app),
       experiments::AddNeesCommand(app),
       experiments::AddMapCommand(app),
+      experiments::AddTerrainCommand(app),
   };
 
   CLI11_PARSE(app, argc, argv);
