@@ -76,15 +76,20 @@ void ObstacleCellMarker::FillRaisedRegions(const StepGrid& steps, const HeightMa
     float* low = heights_low_.ptr<float>(iy);
     float* high = heights_high_.ptr<float>(iy);
     uint8_t* free = free_.ptr<uint8_t>(iy);
-    const uint8_t* obstacle = out->mask.ptr<uint8_t>(iy);
     for (int ix = 0; ix < cols; ++ix) {
       const bool known = map.Has(ix, iy);
       const auto h = static_cast<float>(map.height(ix, iy));
       low[ix] = known ? h : kNoHeight;
       high[ix] = known ? h : -kNoHeight;
-      free[ix] = known && obstacle[ix] == 0 ? 255 : 0;
+      free[ix] = known ? 255 : 0;
     }
   }
+  // Regions of known cells, joined across single unknown cells: a surface
+  // seen at a grazing angle (the far half of a rock's top) is sampled in
+  // rows farther apart than a cell, and would fall apart into islands that
+  // touch no step.
+  cv::morphologyEx(free_, free_, cv::MORPH_CLOSE, cv::Mat::ones(3, 3, CV_8UC1));
+  free_.setTo(0, out->mask);
   const int w = steps_.window_cells;
   const cv::Mat window = cv::Mat::ones(w, w, CV_8UC1);
   const cv::Point anchor(w / 2, w / 2);
@@ -108,7 +113,7 @@ void ObstacleCellMarker::FillRaisedRegions(const StepGrid& steps, const HeightMa
     for (int ix = 0; ix < cols; ++ix) {
       if (label[ix] <= 0) continue;
       uint8_t& verdict = bounded_above_[static_cast<std::size_t>(label[ix])];
-      if (verdict == 0) continue;
+      if (verdict == 0 || !map.Has(ix, iy)) continue;  // a joining cell has no height
       const auto h = static_cast<float>(map.height(ix, iy));
       for (int k = 0; k < 4 && verdict != 0; ++k) {
         const int nx = ix + kDx[k];

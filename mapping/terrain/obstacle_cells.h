@@ -11,7 +11,8 @@
 // the rover can no more drive there than over the flanks. Two steps fill it:
 //  1. Closing (dilate, then erode) the step obstacles with a disc of
 //     `closing_radius_m` joins a ring's gaps and fills small tops.
-//  2. Raised regions: a connected area of known, unflagged cells that is
+//  2. Raised regions: a connected area of known, unflagged cells (joined
+//     across single unknown cells, which sparse sampling leaves) that is
 //     bounded only by obstacle cells (and unknown cells: what the rock
 //     hides, what is out of view) and lies on the upper side of every one
 //     of those bounding steps is the top of what they border, and is
