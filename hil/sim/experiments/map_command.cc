@@ -174,7 +174,7 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
     T_world_body.translation() = s.p_world_body;
     cameras.push_back(T_world_body * T_body_cam0);
   }
-  r.quality = EvaluateMap(world, obstacles, map, cloud, cameras, head.stereo, o.quality);
+  r.quality = EvaluateMap(world, obstacles, rule, map, cloud, cameras, head.stereo, o.quality);
   if (!o.export_stem.empty()) {
     mapping::WriteOctreeBt(map, o.export_stem + ".bt");
     mapping::WritePly(cloud, o.export_stem + ".ply");

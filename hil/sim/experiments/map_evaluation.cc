@@ -120,11 +120,6 @@ void ScoreOccupancy(const sim::World& world, const octomap::OcTree& map, const M
                                           : kNaN;
 }
 
-// Half-width of the window over which a non-rock obstacle cell's relief is
-// taken: the obstacle rule's drop window (0.5 m), which also holds the
-// classifier's 0.3 m step window.
-constexpr int kReliefHalfWindowCells = 5;
-
 // Whether some camera saw the obstacle at (xy, ground height z) within
 // range and field of view from where stereo resolves its relief: relief >
 // h_max + the stereo error of the height difference between its foot and
@@ -132,8 +127,8 @@ constexpr int kReliefHalfWindowCells = 5;
 bool Resolved(const std::vector<Eigen::Isometry3d>& cameras,
               const std::vector<Eigen::Isometry3d>& T_cam_world,
               const mapping::StereoErrorModel& model, const Eigen::Vector2d& xy, double z,
-              double relief_m, const MapQualityOptions& o) {
-  if (relief_m <= o.h_max_m) return false;
+              double relief_m, double h_max_m, const MapQualityOptions& o) {
+  if (relief_m <= h_max_m) return false;
   const Eigen::Vector3d foot(xy.x(), xy.y(), z);
   const Eigen::Vector3d top = foot + relief_m * Eigen::Vector3d::UnitZ();
   for (std::size_t i = 0; i < cameras.size(); ++i) {
@@ -149,41 +144,74 @@ bool Resolved(const std::vector<Eigen::Isometry3d>& cameras,
     const Eigen::Vector3d top_cam = T_cam_world[i] * top;
     if (foot_cam.z() <= 0.0 || top_cam.z() <= 0.0) continue;
     const Eigen::Vector3d up_cam = T_cam_world[i].linear() * Eigen::Vector3d::UnitZ();
-    if (relief_m > o.h_max_m + model.HeightDifferenceSigma(top_cam, foot_cam, up_cam)) {
+    if (relief_m > h_max_m + model.HeightDifferenceSigma(top_cam, foot_cam, up_cam)) {
       return true;
     }
   }
   return false;
 }
 
-// Relief of the obstacle at truth cell (ix, iy): the tallest rock covering
-// it, else the terrain's height range within kReliefHalfWindowCells.
+// Relief of the obstacle at truth cell (ix, iy), by the obstacle rule's
+// own measures (sim::ComputeObstacleCells): the tallest rock covering it;
+// else the larger of the drop below it within the drop window and the
+// step within the step window once the plane fitted over the slope window
+// is taken out (a slope alone is no step).
 double Relief(const sim::World& world, const std::vector<const sim::Rock*>& rocks,
-              const sim::ObstacleGrid& truth, int64_t ix, int64_t iy) {
-  const double x = truth.origin_xy.x() + static_cast<double>(ix) * truth.resolution_m;
-  const double y = truth.origin_xy.y() + static_cast<double>(iy) * truth.resolution_m;
+              const sim::ObstacleGrid& truth, const sim::ObstacleRuleOptions& rule, int64_t ix,
+              int64_t iy) {
+  const double res = truth.resolution_m;
+  const double x = truth.origin_xy.x() + static_cast<double>(ix) * res;
+  const double y = truth.origin_xy.y() + static_cast<double>(iy) * res;
   double rock_m = 0.0;
   for (const sim::Rock* rock : rocks) {
     if (RockBumpHeight(*rock, x, y) > 0.0) rock_m = std::max(rock_m, rock->height_m);
   }
   if (rock_m > 0.0) return rock_m;
   const sim::Heightfield& terrain = world.terrain;
-  double lo = std::numeric_limits<double>::infinity();
-  double hi = -lo;
-  for (int64_t j = iy - kReliefHalfWindowCells; j <= iy + kReliefHalfWindowCells; ++j) {
-    for (int64_t i = ix - kReliefHalfWindowCells; i <= ix + kReliefHalfWindowCells; ++i) {
-      if (i < 0 || j < 0 || i >= terrain.cols() || j >= terrain.rows()) continue;
-      const double h =
-          static_cast<double>(terrain.HeightAtCell(static_cast<int>(i), static_cast<int>(j)));
-      lo = std::min(lo, h);
-      hi = std::max(hi, h);
+  const auto height = [&terrain](int64_t i, int64_t j) {
+    return static_cast<double>(
+        terrain.HeightAtCell(static_cast<int>(std::clamp<int64_t>(i, 0, terrain.cols() - 1)),
+                             static_cast<int>(std::clamp<int64_t>(j, 0, terrain.rows() - 1))));
+  };
+  const auto half_cells = [res](double window_m) {
+    return std::max<int64_t>(1, std::lround(0.5 * window_m / res));
+  };
+  const double centre = height(ix, iy);
+  double drop = 0.0;
+  const int64_t k_drop = half_cells(rule.negative_window_m);
+  for (int64_t j = -k_drop; j <= k_drop; ++j) {
+    for (int64_t i = -k_drop; i <= k_drop; ++i)
+      drop = std::max(drop, centre - height(ix + i, iy + j));
+  }
+  // Least-squares plane on the regular grid: dz/dx = sum(i h) / (res sum(i^2)).
+  const int64_t k_slope = half_cells(rule.slope_window_m);
+  double sum_ih = 0.0, sum_jh = 0.0, sum_i2 = 0.0;
+  for (int64_t j = -k_slope; j <= k_slope; ++j) {
+    for (int64_t i = -k_slope; i <= k_slope; ++i) {
+      const double h = height(ix + i, iy + j);
+      sum_ih += static_cast<double>(i) * h;
+      sum_jh += static_cast<double>(j) * h;
+      sum_i2 += static_cast<double>(i * i);
     }
   }
-  return hi - lo;
+  const double gx = sum_ih / sum_i2;  // per cell
+  const double gy = sum_jh / sum_i2;
+  const int64_t k_step = half_cells(rule.step_window_m);
+  double lo = 0.0, hi = 0.0;
+  for (int64_t j = -k_step; j <= k_step; ++j) {
+    for (int64_t i = -k_step; i <= k_step; ++i) {
+      const double residual = height(ix + i, iy + j) - centre - gx * static_cast<double>(i) -
+                              gy * static_cast<double>(j);
+      lo = std::min(lo, residual);
+      hi = std::max(hi, residual);
+    }
+  }
+  return std::max(drop, hi - lo);
 }
 
 void ScoreObstacles(const sim::World& world, const sim::ObstacleGrid& truth,
-                    const mapping::PointCloud& cloud, const std::vector<Eigen::Isometry3d>& cameras,
+                    const sim::ObstacleRuleOptions& rule, const mapping::PointCloud& cloud,
+                    const std::vector<Eigen::Isometry3d>& cameras,
                     const mapping::RectifiedStereo& head, const MapQualityOptions& o,
                     MapQuality* q) {
   const mapping::StereoErrorModel model(head, o.pixel_error_px);
@@ -254,7 +282,8 @@ void ScoreObstacles(const sim::World& world, const sim::ObstacleGrid& truth,
                                  truth.origin_xy.y() + (static_cast<double>(iy) + 0.5) * res);
       const double z = static_cast<double>(
           world.terrain.HeightAtCell(static_cast<int>(ix), static_cast<int>(iy)));
-      if (!Resolved(cameras, T_cam_world, model, cell, z, Relief(world, rocks, truth, ix, iy), o)) {
+      const double relief = Relief(world, rocks, truth, rule, ix, iy);
+      if (!Resolved(cameras, T_cam_world, model, cell, z, relief, rule.step_height_m, o)) {
         continue;
       }
       ++q->truth_obstacle_cells_observed;
@@ -295,12 +324,13 @@ RectifiedHead RectifiedHeadOf(const sim::StereoCameraOptions& camera) {
 }
 
 MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
-                       const octomap::OcTree& map_world, const mapping::PointCloud& cloud_world,
+                       const sim::ObstacleRuleOptions& rule, const octomap::OcTree& map_world,
+                       const mapping::PointCloud& cloud_world,
                        const std::vector<Eigen::Isometry3d>& T_world_cameras,
                        const mapping::RectifiedStereo& head, const MapQualityOptions& options) {
   MapQuality q;
   ScoreOccupancy(world, map_world, options, &q);
-  ScoreObstacles(world, truth, cloud_world, T_world_cameras, head, options, &q);
+  ScoreObstacles(world, truth, rule, cloud_world, T_world_cameras, head, options, &q);
   return q;
 }
 

@@ -28,8 +28,9 @@
 //    camera's horizontal field of view) at one of the given camera poses,
 //    from where stereo resolves it. Stereo error grows with the square of
 //    the distance: an obstacle is resolved from a pose when its relief
-//    (the rock's height for a rock's cells, else the terrain's height range
-//    within 0.25 m) exceeds h_max by more than the stereo error of that
+//    (the rock's height for a rock's cells, else the drop or the step the
+//    obstacle rule measured there) exceeds h_max by more than the stereo
+//    error of that
 //    height difference there (first order, the head's rectified geometry
 //    at `pixel_error_px`). A 0.48 m boulder is resolved at 4 m; a rock
 //    2.5 cm taller than h_max only within about 1.5 m on the simulator's
@@ -59,8 +60,6 @@ struct MapQualityOptions {
   double carrier_margin_m = 0.3;
   double obstacle_view_range_m = 4.0;
   double camera_half_fov_rad = 0.6;
-  /// Highest step a wheel climbs (the obstacle rule's step height).
-  double h_max_m = 0.1;
   /// Stereo matching error per image coordinate (thesis: 0.5 px).
   double pixel_error_px = 0.5;
 };
@@ -91,12 +90,14 @@ struct RectifiedHead {
 RectifiedHead RectifiedHeadOf(const sim::StereoCameraOptions& camera);
 
 /// Scores `map_world` and `cloud_world` (CloudPoint::p_submap_m in world
-/// coordinates) against `world` and its obstacle grid `truth`.
+/// coordinates) against `world` and its obstacle grid `truth` (computed
+/// with `rule`).
 /// `T_world_cameras` are the rectified left camera's true poses along the
 /// mission (for the obstacles' view range; OpenCV axes, z forward), `head`
 /// its rectified geometry.
 MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
-                       const octomap::OcTree& map_world, const mapping::PointCloud& cloud_world,
+                       const sim::ObstacleRuleOptions& rule, const octomap::OcTree& map_world,
+                       const mapping::PointCloud& cloud_world,
                        const std::vector<Eigen::Isometry3d>& T_world_cameras,
                        const mapping::RectifiedStereo& head, const MapQualityOptions& options = {});
 

@@ -99,8 +99,8 @@ TerrainResult EvaluateTerrain(const TerrainCommandOptions& options, uint64_t see
   for (double t_s = 0.0; t_s <= end_s; t_s += 0.25) {
     cameras.push_back(PoseOf(trajectory.Evaluate(t_s)) * head.T_body_cam0rect);
   }
-  result.quality = EvaluateMap(world, truth, submap.octree(), submap.cloud(), cameras, head.stereo,
-                               options.quality);
+  result.quality = EvaluateMap(world, truth, rule, submap.octree(), submap.cloud(), cameras,
+                               head.stereo, options.quality);
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
