@@ -231,6 +231,7 @@ void ScoreObstacles(const sim::World& world, const sim::ObstacleGrid& truth,
     const sim::ObstacleCode c = truth.CodeAt(static_cast<int>(ix), static_cast<int>(iy));
     return c == sim::ObstacleCode::kPositive || c == sim::ObstacleCode::kNegative;
   };
+  const std::vector<Disc> posts = CarrierDiscs(world, o.obstacle_radius_m);
   const int reach = static_cast<int>(std::ceil(o.obstacle_radius_m / res));
   const double reach2 = (o.obstacle_radius_m / res) * (o.obstacle_radius_m / res);
   std::unordered_set<int64_t> seen;
@@ -248,7 +249,9 @@ void ScoreObstacles(const sim::World& world, const sim::ObstacleGrid& truth,
     if (!p.obstacle) continue;
     ++q->obstacle_points;
     flagged.insert(CellKey(ix, iy));
-    bool near = false;
+    // A landmark post is an obstacle as much as a rock, though the
+    // heightfield and so the obstacle grid do not hold it.
+    bool near = NearCarrier(posts, p.p_submap_m.head<2>().cast<double>());
     for (int dy = -reach; dy <= reach && !near; ++dy) {
       for (int dx = -reach; dx <= reach && !near; ++dx) {
         near = dx * dx + dy * dy <= reach2 && is_obstacle(ix + dx, iy + dy);

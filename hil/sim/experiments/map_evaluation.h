@@ -20,7 +20,9 @@
 // rock_min_height_m = h_max so that only rocks taller than a wheel can
 // climb count, plus steps and the top edges of drops):
 //  * precision = obstacle-flagged cloud points within `obstacle_radius_m`
-//    of a ground-truth obstacle cell / flagged points;
+//    of a ground-truth obstacle cell or of a tag carrier's footprint (a
+//    landmark post is an obstacle too, though not part of the heightfield)
+//    / flagged points;
 //  * recall = ground-truth obstacle cells with a flagged point within
 //    `obstacle_radius_m` / ground-truth obstacle cells that were observed:
 //    the map has a point within one cell of it, and the camera saw it from
