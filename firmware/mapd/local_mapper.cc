@@ -2,8 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-
-#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -43,11 +41,6 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 void LocalMapperOptions::Validate() const {
   disparity.Validate();
   depth.Validate();
-  if (!(obstacle_closing_radius_m >= 0.0) || obstacle_closing_radius_m > 2.0) {
-    throw std::invalid_argument(
-        "LocalMapperOptions.obstacle_closing_radius_m: expected 0..2 m, got " +
-        std::to_string(obstacle_closing_radius_m));
-  }
   if (!(pixel_error_px > 0.0)) {
     throw std::invalid_argument("LocalMapperOptions.pixel_error_px: expected > 0, got " +
                                 std::to_string(pixel_error_px));
@@ -55,6 +48,11 @@ void LocalMapperOptions::Validate() const {
   height_map.Validate();
   steps.Validate();
   negative_edges.Validate();
+  obstacle_cells.Validate();
+  if (min_obstacle_images < 1 || min_obstacle_images > 255) {
+    throw std::invalid_argument("LocalMapperOptions.min_obstacle_images: expected 1..255, got " +
+                                std::to_string(min_obstacle_images));
+  }
   traversability.Validate();
 }
 
@@ -67,6 +65,7 @@ LocalMapper::LocalMapper(const LocalMapperOptions& options, const calib::CameraM
       disparity_(options.disparity),
       steps_(options.steps, error_model_),
       edges_(options.negative_edges),
+      obstacle_marker_(options.obstacle_cells, options.steps),
       grid_(options.traversability),
       T_body_cam_(rectifier_.T_body_cam0rect()) {}
 
@@ -101,7 +100,10 @@ MappedImage LocalMapper::Process(const cv::Mat& raw0, const cv::Mat& raw1,
   grid_.Recentre(T_local_body.translation().head<2>());
   grid_.Add(steps, edges);
   out.negative_edges = static_cast<int>(edges.size());
-  out.obstacle_points = MarkObstacles(steps, edges, T_local_cam);
+  obstacle_marker_.Mark(steps, heights, &obstacle_cells_);
+  grid_.CountObstacles(obstacle_cells_);
+  grid_.KeepConfirmed(options_.min_obstacle_images, &obstacle_cells_);
+  out.obstacle_points = MarkObstacles(edges, T_local_cam);
   out.classification_ms = MillisecondsSince(start);
 
   start = std::chrono::steady_clock::now();
@@ -110,36 +112,19 @@ MappedImage LocalMapper::Process(const cv::Mat& raw0, const cv::Mat& raw1,
   return out;
 }
 
-int LocalMapper::MarkObstacles(const mapping::StepGrid& steps,
-                               const std::vector<mapping::NegativeEdge>& edges,
+int LocalMapper::MarkObstacles(const std::vector<mapping::NegativeEdge>& edges,
                                const Eigen::Isometry3d& T_local_cam) {
   const int w = depth_.width();
   const int h = depth_.height();
   obstacle_mask_.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
   int flagged = 0;
-  step_obstacles_.create(steps.rows, steps.cols, CV_8UC1);
-  for (int iy = 0; iy < steps.rows; ++iy) {
-    uint8_t* row = step_obstacles_.ptr<uint8_t>(iy);
-    for (int ix = 0; ix < steps.cols; ++ix) row[ix] = steps.Obstacle(ix, iy) ? 255 : 0;
-  }
-  const int radius =
-      static_cast<int>(std::lround(options_.obstacle_closing_radius_m / steps.resolution_m));
-  if (radius > 0) {
-    const cv::Mat disc =
-        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
-    cv::morphologyEx(step_obstacles_, step_obstacles_, cv::MORPH_CLOSE, disc);
-  }
   const Eigen::Isometry3f T = T_local_cam.cast<float>();
-  const auto res = static_cast<float>(steps.resolution_m);
-  const Eigen::Vector2f origin = steps.origin_xy.cast<float>();
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       if (depth_.state(u, v) != mapping::DepthState::kValid) continue;
       const Eigen::Vector3f p = T * depth_.point(u, v);
-      const auto ix = static_cast<int>(std::floor((p.x() - origin.x()) / res));
-      const auto iy = static_cast<int>(std::floor((p.y() - origin.y()) / res));
-      if (ix < 0 || iy < 0 || ix >= steps.cols || iy >= steps.rows) continue;
-      if (step_obstacles_.at<uint8_t>(iy, ix) == 0) continue;
+      int ix = 0, iy = 0;
+      if (!obstacle_cells_.CellOf(p, &ix, &iy) || !obstacle_cells_.Obstacle(ix, iy)) continue;
       obstacle_mask_[static_cast<std::size_t>(v) * static_cast<std::size_t>(w) +
                      static_cast<std::size_t>(u)] = 1;
       ++flagged;

@@ -20,6 +20,7 @@
 #include "mapping/submap/submap.h"
 #include "mapping/terrain/height_map.h"
 #include "mapping/terrain/negative_edge_detector.h"
+#include "mapping/terrain/obstacle_cells.h"
 #include "mapping/terrain/step_classifier.h"
 #include "mapping/terrain/traversability_grid.h"
 
@@ -34,11 +35,15 @@ struct LocalMapperOptions {
   mapping::StepClassifierOptions steps;
   mapping::NegativeEdgeOptions negative_edges;
   mapping::TraversabilityGridOptions traversability;
-  /// Obstacle cells of the step grid are closed (dilated, then eroded) with
-  /// a disc of this radius: a rock's flat top, which no window of the step
-  /// test spans, lies inside the ring its edges flag and is as impassable.
-  /// 0 disables it.
-  double obstacle_closing_radius_m = 0.25;
+  /// Whole obstacles from the step grid (closing, raised regions).
+  mapping::ObstacleCellOptions obstacle_cells;
+  /// A point is flagged once this many images (this one included) have
+  /// classified a cell of its obstacle as one (TraversabilityGrid::
+  /// KeepConfirmed). Wrong stereo matches at the far end of the range make
+  /// steps that the next pair, seen from 15 cm further on, does not repeat;
+  /// a rock stays. 1 flags on the first sight. Negative edges are flagged
+  /// at once.
+  int min_obstacle_images = 2;
 
   /// Throws std::invalid_argument naming the component and key.
   void Validate() const;
@@ -80,9 +85,9 @@ class LocalMapper {
   const std::vector<uint8_t>& last_obstacle_mask() const { return obstacle_mask_; }
 
  private:
-  /// Per-pixel obstacle flags of the valid points: on a step obstacle cell or
-  /// at a negative edge.
-  int MarkObstacles(const mapping::StepGrid& steps, const std::vector<mapping::NegativeEdge>& edges,
+  /// Per-pixel obstacle flags of the valid points: on a confirmed obstacle
+  /// cell of this image, or at a negative edge.
+  int MarkObstacles(const std::vector<mapping::NegativeEdge>& edges,
                     const Eigen::Isometry3d& T_local_cam);
 
   LocalMapperOptions options_;
@@ -92,13 +97,14 @@ class LocalMapper {
   mapping::DisparityEstimator disparity_;
   mapping::StepClassifier steps_;
   mapping::NegativeEdgeDetector edges_;
+  mapping::ObstacleCellMarker obstacle_marker_;
   mapping::TraversabilityGrid grid_;
   Eigen::Isometry3d T_body_cam_ = Eigen::Isometry3d::Identity();
   cv::Mat rect0_, rect1_, disparity_q4_;
   mapping::DepthImage depth_;
   bool has_depth_ = false;
   std::vector<uint8_t> obstacle_mask_;
-  cv::Mat step_obstacles_;  ///< CV_8U over the step grid, closed
+  mapping::ObstacleCells obstacle_cells_;  ///< the latest image's
 };
 
 }  // namespace rover::mapd

@@ -18,6 +18,7 @@
 #include "hil/sim/experiments/loop_command.h"
 #include "hil/sim/experiments/map_command.h"
 #include "hil/sim/experiments/nees_command.h"
+#include "hil/sim/experiments/terrain_command.h"
 #include "hil/sim/imu_mission.h"
 #include "hil/sim/live/sim_can_bus.h"
 #include "hil/sim/scenario/scenario.h"
@@ -295,6 +296,7 @@ int main(int argc, char** argv) {
       experiments::AddNeesCommand(app),
       experiments::AddMapCommand(app),
       experiments::AddLoopCommand(app),
+      experiments::AddTerrainCommand(app),
   };
 
   CLI11_PARSE(app, argc, argv);

@@ -54,4 +54,13 @@ double StereoErrorModel::DistanceSigma(const Eigen::Vector3d& p, const Eigen::Ve
   return pixel_error_px_ * std::sqrt(gp.squaredNorm() + gq.squaredNorm());
 }
 
+double StereoErrorModel::HeightDifferenceSigma(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                                               const Eigen::Vector3d& up_cam) const {
+  // d((p - q) . up) / dp = up^T, / dq = -up^T; the two points' image
+  // coordinates are independent.
+  const Eigen::RowVector4d gp = up_cam.transpose() * PointJacobian(p);
+  const Eigen::RowVector4d gq = up_cam.transpose() * PointJacobian(q);
+  return pixel_error_px_ * std::sqrt(gp.squaredNorm() + gq.squaredNorm());
+}
+
 }  // namespace rover::mapping

@@ -48,7 +48,13 @@ std::vector<NegativeEdge> NegativeEdgeDetector::Detect(
       const Eigen::Vector3d q = T_gravity_cam * q_cam;
       if (HasPoint(upper)) {
         const Eigen::Vector3d p_cam = depth.point(u, v - 1).cast<double>();
-        if (p_cam.z() - q_cam.z() <= options_.depth_jump_m) continue;  // far side farther
+        // A jump, and one that the two depths' stereo error does not explain.
+        double jump_m = options_.depth_jump_m;
+        if (options_.error_adaptive) {
+          jump_m += std::hypot(static_cast<double>(depth.depth_sigma(u, v - 1)),
+                               static_cast<double>(depth.depth_sigma(u, v)));
+        }
+        if (p_cam.z() - q_cam.z() <= jump_m) continue;
         const Eigen::Vector3d p = T_gravity_cam * p_cam;
         const double run = (q.head<2>() - p.head<2>()).norm();
         const double drop = q.z() - p.z();

@@ -8,7 +8,8 @@
 //
 // Each column is walked top to bottom and every pixel compared with its
 // upper neighbour. Where their depths differ by more than `depth_jump_m`
-// (0.2 m on the thesis's rovers), the upper pixel's point p lies beyond the
+// (0.2 m on the thesis's rovers; plus the stereo error of the difference,
+// see the option), the upper pixel's point p lies beyond the
 // edge and the lower pixel's point q on its near side. In the
 // gravity-aligned frame the steepest slope the unseen ground between them
 // must have somewhere is at least
@@ -34,6 +35,13 @@ namespace rover::mapping {
 
 struct NegativeEdgeOptions {
   double depth_jump_m = 0.2;
+  /// Add the stereo error of the two depths' difference (sqrt(sigma_z,p^2 +
+  /// sigma_z,q^2)) to `depth_jump_m`, as the step test adds its error: the
+  /// thesis's 0.2 m is many sigma at 2 m on its f = 1080 px heads (sigma_z
+  /// 3 cm), but barely more than one on the simulator's f = 422 px head
+  /// (7 cm), where a wrong match along a ray steeper than max_slope_deg
+  /// would pass for an edge. A real drop hides metres of ground.
+  bool error_adaptive = true;
   /// Steepest traversable slope (the simulator's obstacle rule uses 25 deg).
   double max_slope_deg = 25.0;
   /// Flag infinitely far upper neighbours (see the file comment).

@@ -37,6 +37,7 @@ StepGrid StepClassifier::Classify(const HeightMap& map,
   grid.traversability.assign(
       static_cast<std::size_t>(grid.cols) * static_cast<std::size_t>(grid.rows), -1.0f);
   const Eigen::Isometry3d T_cam_gravity = T_gravity_cam.inverse();
+  const Eigen::Vector3d up_cam = T_cam_gravity.linear() * Eigen::Vector3d::UnitZ();
   const int lo = options_.window_cells / 2;  // window: [i - lo, i - lo + window)
   for (int iy = 0; iy < map.rows(); ++iy) {
     for (int ix = 0; ix < map.cols(); ++ix) {
@@ -66,7 +67,10 @@ StepGrid StepClassifier::Classify(const HeightMap& map,
         const Eigen::Vector3d p = T_cam_gravity * map.CellPoint(max_x, max_y);
         const Eigen::Vector3d q = T_cam_gravity * map.CellPoint(min_x, min_y);
         if (p.z() > 0.0 && q.z() > 0.0) {
-          threshold += options_.sigma_factor * model_.DistanceSigma(p, q);
+          const double sigma = options_.error_term == StepErrorTerm::kDistance
+                                   ? model_.DistanceSigma(p, q)
+                                   : model_.HeightDifferenceSigma(p, q, up_cam);
+          threshold += options_.sigma_factor * sigma;
         }
       }
       grid.traversability[static_cast<std::size_t>(iy) * static_cast<std::size_t>(grid.cols) +

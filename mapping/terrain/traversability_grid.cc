@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <opencv2/imgproc.hpp>
+
 namespace rover::mapping {
 
 void TraversabilityGridOptions::Validate() const {
@@ -34,6 +36,8 @@ TraversabilityGrid::TraversabilityGrid(const TraversabilityGridOptions& options)
   n_ = 2 * static_cast<int>(std::ceil(options_.half_extent_m / options_.resolution_m));
   values_.assign(static_cast<std::size_t>(n_) * static_cast<std::size_t>(n_), -1.0f);
   scratch_ = values_;
+  obstacle_images_.assign(values_.size(), 0);
+  obstacle_scratch_ = obstacle_images_;
   origin_cx_ = origin_cy_ = -n_ / 2;
 }
 
@@ -56,6 +60,7 @@ void TraversabilityGrid::Recentre(const Eigen::Vector2d& rover_xy) {
   const long cy = static_cast<long>(std::floor(rover_xy.y() / options_.resolution_m)) - n_ / 2;
   if (cx == origin_cx_ && cy == origin_cy_) return;
   std::fill(scratch_.begin(), scratch_.end(), -1.0f);
+  std::fill(obstacle_scratch_.begin(), obstacle_scratch_.end(), 0);
   for (int iy = 0; iy < n_; ++iy) {
     for (int ix = 0; ix < n_; ++ix) {
       const long gx = origin_cx_ + ix;
@@ -63,11 +68,16 @@ void TraversabilityGrid::Recentre(const Eigen::Vector2d& rover_xy) {
       const long nx = gx - cx;
       const long ny = gy - cy;
       if (nx < 0 || ny < 0 || nx >= n_ || ny >= n_) continue;  // scrolled off: forgotten
-      scratch_[static_cast<std::size_t>(ny) * static_cast<std::size_t>(n_) +
-               static_cast<std::size_t>(nx)] = value(ix, iy);
+      const std::size_t from = static_cast<std::size_t>(iy) * static_cast<std::size_t>(n_) +
+                               static_cast<std::size_t>(ix);
+      const std::size_t to = static_cast<std::size_t>(ny) * static_cast<std::size_t>(n_) +
+                             static_cast<std::size_t>(nx);
+      scratch_[to] = values_[from];
+      obstacle_scratch_[to] = obstacle_images_[from];
     }
   }
   values_.swap(scratch_);
+  obstacle_images_.swap(obstacle_scratch_);
   origin_cx_ = cx;
   origin_cy_ = cy;
 }
@@ -102,6 +112,59 @@ void TraversabilityGrid::Add(const StepGrid& steps, const std::vector<NegativeEd
     float& v = values_[static_cast<std::size_t>(iy) * static_cast<std::size_t>(n_) +
                        static_cast<std::size_t>(ix)];
     v = std::max(v, options_.negative_edge_value);
+  }
+}
+
+void TraversabilityGrid::CountObstacles(const ObstacleCells& cells) {
+  const double r = options_.resolution_m;
+  for (int iy = 0; iy < cells.rows; ++iy) {
+    const uint8_t* row = cells.mask.ptr<uint8_t>(iy);
+    for (int ix = 0; ix < cells.cols; ++ix) {
+      if (row[ix] == 0) continue;
+      const double x = cells.origin_xy.x() + (ix + 0.5) * cells.resolution_m;
+      const double y = cells.origin_xy.y() + (iy + 0.5) * cells.resolution_m;
+      int lx = 0, ly = 0;
+      if (!Local(static_cast<long>(std::floor(x / r)), static_cast<long>(std::floor(y / r)), &lx,
+                 &ly)) {
+        continue;
+      }
+      uint8_t& n = obstacle_images_[static_cast<std::size_t>(ly) * static_cast<std::size_t>(n_) +
+                                    static_cast<std::size_t>(lx)];
+      if (n < 255) ++n;
+    }
+  }
+}
+
+int TraversabilityGrid::ObstacleImages(const Eigen::Vector2d& xy) const {
+  int ix = 0, iy = 0;
+  if (!Local(static_cast<long>(std::floor(xy.x() / options_.resolution_m)),
+             static_cast<long>(std::floor(xy.y() / options_.resolution_m)), &ix, &iy)) {
+    return 0;
+  }
+  return obstacle_images_[static_cast<std::size_t>(iy) * static_cast<std::size_t>(n_) +
+                          static_cast<std::size_t>(ix)];
+}
+
+void TraversabilityGrid::KeepConfirmed(int min_images, ObstacleCells* cells) {
+  const int labels = cv::connectedComponents(cells->mask, labels_, 8, CV_32S);
+  confirmed_.assign(static_cast<std::size_t>(labels), 0);
+  const auto cell_images = [&](int ix, int iy) {
+    return ObstacleImages({cells->origin_xy.x() + (ix + 0.5) * cells->resolution_m,
+                           cells->origin_xy.y() + (iy + 0.5) * cells->resolution_m});
+  };
+  for (int iy = 0; iy < cells->rows; ++iy) {
+    const int32_t* label = labels_.ptr<int32_t>(iy);
+    for (int ix = 0; ix < cells->cols; ++ix) {
+      uint8_t& confirmed = confirmed_[static_cast<std::size_t>(label[ix])];
+      if (label[ix] > 0 && confirmed == 0 && cell_images(ix, iy) >= min_images) confirmed = 1;
+    }
+  }
+  for (int iy = 0; iy < cells->rows; ++iy) {
+    const int32_t* label = labels_.ptr<int32_t>(iy);
+    uint8_t* row = cells->mask.ptr<uint8_t>(iy);
+    for (int ix = 0; ix < cells->cols; ++ix) {
+      if (confirmed_[static_cast<std::size_t>(label[ix])] == 0) row[ix] = 0;
+    }
   }
 }
 

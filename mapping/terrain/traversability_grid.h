@@ -7,13 +7,21 @@
 // (> 1: untraversable); negative edges set their cells to a value above 1.
 // When the rover moves, the grid scrolls by whole cells and what falls off
 // the edge is forgotten, so memory is fixed and no allocation happens after
-// construction.
+// construction. Each cell also counts the images whose obstacle cells
+// (ObstacleCells: whole obstacles) included it, so that an obstacle can be
+// confirmed by another look before the map takes it: a wrong stereo match
+// rarely repeats from the next viewpoint, a rock does. Confirmation is per
+// obstacle (a connected group of obstacle cells), not per cell: the far
+// half of a rock's top, seen at a grazing angle, comes and goes from image
+// to image while its flanks stay.
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "mapping/terrain/negative_edge_detector.h"
+#include "mapping/terrain/obstacle_cells.h"
 #include "mapping/terrain/step_classifier.h"
 
 namespace rover::mapping {
@@ -38,6 +46,15 @@ class TraversabilityGrid {
   void Recentre(const Eigen::Vector2d& rover_xy);
   /// Folds one image's step classification and negative edges in.
   void Add(const StepGrid& steps, const std::vector<NegativeEdge>& edges);
+  /// Counts one image's obstacle cells (saturating at 255 images).
+  void CountObstacles(const ObstacleCells& cells);
+  /// Images whose obstacle cells included the cell at a gravity-frame
+  /// point; 0 if none or outside the grid.
+  int ObstacleImages(const Eigen::Vector2d& xy) const;
+  /// Clears the obstacles of `cells` (8-connected groups of obstacle cells)
+  /// of which no cell has been counted in `min_images` images yet. Call
+  /// after CountObstacles(*cells).
+  void KeepConfirmed(int min_images, ObstacleCells* cells);
 
   int cells_per_side() const { return n_; }
   double resolution_m() const { return options_.resolution_m; }
@@ -61,6 +78,10 @@ class TraversabilityGrid {
   long origin_cy_ = 0;
   std::vector<float> values_;
   std::vector<float> scratch_;
+  std::vector<uint8_t> obstacle_images_;
+  std::vector<uint8_t> obstacle_scratch_;
+  cv::Mat labels_;
+  std::vector<uint8_t> confirmed_;
 };
 
 }  // namespace rover::mapping

@@ -203,9 +203,11 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   sim::ObstacleRuleOptions rule;
   rule.rock_min_height_m = rule.step_height_m;  // rocks taller than a wheel climbs
   const sim::ObstacleGrid obstacles = sim::ComputeObstacleCells(world, rule);
-  // The true camera along the mapped part of the mission, every 0.25 s.
+  // The true (rectified) camera along the mapped part of the mission, every
+  // 0.25 s.
   std::vector<Eigen::Isometry3d> cameras;
-  const Eigen::Isometry3d T_body_cam0 = scenario.camera.T_body_cam0;
+  const RectifiedHead head = RectifiedHeadOf(scenario.camera);
+  const Eigen::Isometry3d T_body_cam0 = head.T_body_cam0rect;
   for (Time t = mission.init_stamp; t <= mission.last_stamp; t = t + Duration::FromSeconds(0.25)) {
     const sim::TrajectorySample s = trajectory.Evaluate((t - mission.start).ToSeconds());
     Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
@@ -213,7 +215,7 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
     T_world_body.translation() = s.p_world_body;
     cameras.push_back(T_world_body * T_body_cam0);
   }
-  r.quality = EvaluateMap(world, obstacles, map, cloud, cameras, o.quality);
+  r.quality = EvaluateMap(world, obstacles, rule, map, cloud, cameras, head.stereo, o.quality);
   if (!o.export_stem.empty()) {
     mapping::WriteOctreeBt(map, o.export_stem + ".bt");
     mapping::WritePly(cloud, o.export_stem + ".ply");
@@ -290,7 +292,8 @@ Subcommand AddMapCommand(CLI::App& app) {
                   "a flagged point within this of a true obstacle cell is correct")
       ->capture_default_str();
   cmd->add_option("--obstacle-view-range-m", options->quality.obstacle_view_range_m,
-                  "recall counts the true obstacles the camera saw from within this distance")
+                  "recall counts the true obstacles the camera saw from within this distance, "
+                  "from where stereo resolves their height above a wheel's step")
       ->capture_default_str();
   return {cmd, [options] { return RunMap(*options, std::cout, std::cerr); }};
 }

@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
+
+#include "core/calib/stereo_rectifier.h"
+#include "mapping/depth/stereo_error_model.h"
 
 namespace rover::sim::experiments {
 namespace {
@@ -116,25 +120,104 @@ void ScoreOccupancy(const sim::World& world, const octomap::OcTree& map, const M
                                           : kNaN;
 }
 
-// Whether some camera saw the horizontal point xy within range and field
-// of view.
-bool SeenClose(const std::vector<Eigen::Isometry3d>& cameras, const Eigen::Vector2d& xy,
-               const MapQualityOptions& o) {
-  for (const Eigen::Isometry3d& T : cameras) {
+// Whether some camera saw the obstacle at (xy, ground height z) within
+// range and field of view from where stereo resolves its relief: relief >
+// h_max + the stereo error of the height difference between its foot and
+// its top.
+bool Resolved(const std::vector<Eigen::Isometry3d>& cameras,
+              const std::vector<Eigen::Isometry3d>& T_cam_world,
+              const mapping::StereoErrorModel& model, const Eigen::Vector2d& xy, double z,
+              double relief_m, double h_max_m, const MapQualityOptions& o) {
+  if (relief_m <= h_max_m) return false;
+  const Eigen::Vector3d foot(xy.x(), xy.y(), z);
+  const Eigen::Vector3d top = foot + relief_m * Eigen::Vector3d::UnitZ();
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const Eigen::Isometry3d& T = cameras[i];
     const Eigen::Vector2d to = xy - T.translation().head<2>();
     const double range = to.norm();
     if (range > o.obstacle_view_range_m || range < 1e-6) continue;
     const Eigen::Vector2d forward = (T.linear() * Eigen::Vector3d::UnitZ()).head<2>();
     if (forward.norm() < 1e-6) continue;
     const double cos_angle = forward.normalized().dot(to / range);
-    if (cos_angle >= std::cos(o.camera_half_fov_rad)) return true;
+    if (cos_angle < std::cos(o.camera_half_fov_rad)) continue;
+    const Eigen::Vector3d foot_cam = T_cam_world[i] * foot;
+    const Eigen::Vector3d top_cam = T_cam_world[i] * top;
+    if (foot_cam.z() <= 0.0 || top_cam.z() <= 0.0) continue;
+    const Eigen::Vector3d up_cam = T_cam_world[i].linear() * Eigen::Vector3d::UnitZ();
+    if (relief_m > h_max_m + model.HeightDifferenceSigma(top_cam, foot_cam, up_cam)) {
+      return true;
+    }
   }
   return false;
 }
 
-void ScoreObstacles(const sim::ObstacleGrid& truth, const mapping::PointCloud& cloud,
-                    const std::vector<Eigen::Isometry3d>& cameras, const MapQualityOptions& o,
+// Relief of the obstacle at truth cell (ix, iy), by the obstacle rule's
+// own measures (sim::ComputeObstacleCells): the tallest rock covering it;
+// else the larger of the drop below it within the drop window and the
+// step within the step window once the plane fitted over the slope window
+// is taken out (a slope alone is no step).
+double Relief(const sim::World& world, const std::vector<const sim::Rock*>& rocks,
+              const sim::ObstacleGrid& truth, const sim::ObstacleRuleOptions& rule, int64_t ix,
+              int64_t iy) {
+  const double res = truth.resolution_m;
+  const double x = truth.origin_xy.x() + static_cast<double>(ix) * res;
+  const double y = truth.origin_xy.y() + static_cast<double>(iy) * res;
+  double rock_m = 0.0;
+  for (const sim::Rock* rock : rocks) {
+    if (RockBumpHeight(*rock, x, y) > 0.0) rock_m = std::max(rock_m, rock->height_m);
+  }
+  if (rock_m > 0.0) return rock_m;
+  const sim::Heightfield& terrain = world.terrain;
+  const auto height = [&terrain](int64_t i, int64_t j) {
+    return static_cast<double>(
+        terrain.HeightAtCell(static_cast<int>(std::clamp<int64_t>(i, 0, terrain.cols() - 1)),
+                             static_cast<int>(std::clamp<int64_t>(j, 0, terrain.rows() - 1))));
+  };
+  const auto half_cells = [res](double window_m) {
+    return std::max<int64_t>(1, std::lround(0.5 * window_m / res));
+  };
+  const double centre = height(ix, iy);
+  double drop = 0.0;
+  const int64_t k_drop = half_cells(rule.negative_window_m);
+  for (int64_t j = -k_drop; j <= k_drop; ++j) {
+    for (int64_t i = -k_drop; i <= k_drop; ++i)
+      drop = std::max(drop, centre - height(ix + i, iy + j));
+  }
+  // Least-squares plane on the regular grid: dz/dx = sum(i h) / (res sum(i^2)).
+  const int64_t k_slope = half_cells(rule.slope_window_m);
+  double sum_ih = 0.0, sum_jh = 0.0, sum_i2 = 0.0;
+  for (int64_t j = -k_slope; j <= k_slope; ++j) {
+    for (int64_t i = -k_slope; i <= k_slope; ++i) {
+      const double h = height(ix + i, iy + j);
+      sum_ih += static_cast<double>(i) * h;
+      sum_jh += static_cast<double>(j) * h;
+      sum_i2 += static_cast<double>(i * i);
+    }
+  }
+  const double gx = sum_ih / sum_i2;  // per cell
+  const double gy = sum_jh / sum_i2;
+  const int64_t k_step = half_cells(rule.step_window_m);
+  double lo = 0.0, hi = 0.0;
+  for (int64_t j = -k_step; j <= k_step; ++j) {
+    for (int64_t i = -k_step; i <= k_step; ++i) {
+      const double residual = height(ix + i, iy + j) - centre - gx * static_cast<double>(i) -
+                              gy * static_cast<double>(j);
+      lo = std::min(lo, residual);
+      hi = std::max(hi, residual);
+    }
+  }
+  return std::max(drop, hi - lo);
+}
+
+void ScoreObstacles(const sim::World& world, const sim::ObstacleGrid& truth,
+                    const sim::ObstacleRuleOptions& rule, const mapping::PointCloud& cloud,
+                    const std::vector<Eigen::Isometry3d>& cameras,
+                    const mapping::RectifiedStereo& head, const MapQualityOptions& o,
                     MapQuality* q) {
+  const mapping::StereoErrorModel model(head, o.pixel_error_px);
+  std::vector<Eigen::Isometry3d> T_cam_world;
+  T_cam_world.reserve(cameras.size());
+  for (const Eigen::Isometry3d& T : cameras) T_cam_world.push_back(T.inverse());
   const double res = truth.resolution_m;
   const auto cell_of = [&](const Eigen::Vector3f& p, int64_t* ix, int64_t* iy) {
     *ix =
@@ -148,6 +231,7 @@ void ScoreObstacles(const sim::ObstacleGrid& truth, const mapping::PointCloud& c
     const sim::ObstacleCode c = truth.CodeAt(static_cast<int>(ix), static_cast<int>(iy));
     return c == sim::ObstacleCode::kPositive || c == sim::ObstacleCode::kNegative;
   };
+  const std::vector<Disc> posts = CarrierDiscs(world, o.obstacle_radius_m);
   const int reach = static_cast<int>(std::ceil(o.obstacle_radius_m / res));
   const double reach2 = (o.obstacle_radius_m / res) * (o.obstacle_radius_m / res);
   std::unordered_set<int64_t> seen;
@@ -165,13 +249,28 @@ void ScoreObstacles(const sim::ObstacleGrid& truth, const mapping::PointCloud& c
     if (!p.obstacle) continue;
     ++q->obstacle_points;
     flagged.insert(CellKey(ix, iy));
-    bool near = false;
+    // A landmark post is an obstacle as much as a rock, though the
+    // heightfield and so the obstacle grid do not hold it.
+    bool near = NearCarrier(posts, p.p_submap_m.head<2>().cast<double>());
     for (int dy = -reach; dy <= reach && !near; ++dy) {
       for (int dx = -reach; dx <= reach && !near; ++dx) {
         near = dx * dx + dy * dy <= reach2 && is_obstacle(ix + dx, iy + dy);
       }
     }
     if (near) ++q->obstacle_points_true;
+  }
+  // The rocks that reach into the mapped area.
+  std::vector<const sim::Rock*> rocks;
+  const double x_lo = truth.origin_xy.x() + static_cast<double>(min_x) * res;
+  const double x_hi = truth.origin_xy.x() + static_cast<double>(max_x + 1) * res;
+  const double y_lo = truth.origin_xy.y() + static_cast<double>(min_y) * res;
+  const double y_hi = truth.origin_xy.y() + static_cast<double>(max_y + 1) * res;
+  for (const sim::Rock& rock : world.rocks) {
+    const double r = RockOuterRadius(rock);
+    if (rock.center_xy.x() + r >= x_lo && rock.center_xy.x() - r <= x_hi &&
+        rock.center_xy.y() + r >= y_lo && rock.center_xy.y() - r <= y_hi) {
+      rocks.push_back(&rock);
+    }
   }
   for (int64_t iy = min_y; iy <= max_y; ++iy) {
     for (int64_t ix = min_x; ix <= max_x; ++ix) {
@@ -184,7 +283,12 @@ void ScoreObstacles(const sim::ObstacleGrid& truth, const mapping::PointCloud& c
       if (!observed) continue;
       const Eigen::Vector2d cell(truth.origin_xy.x() + (static_cast<double>(ix) + 0.5) * res,
                                  truth.origin_xy.y() + (static_cast<double>(iy) + 0.5) * res);
-      if (!SeenClose(cameras, cell, o)) continue;
+      const double z = static_cast<double>(
+          world.terrain.HeightAtCell(static_cast<int>(ix), static_cast<int>(iy)));
+      const double relief = Relief(world, rocks, truth, rule, ix, iy);
+      if (!Resolved(cameras, T_cam_world, model, cell, z, relief, rule.step_height_m, o)) {
+        continue;
+      }
       ++q->truth_obstacle_cells_observed;
       bool found = false;
       for (int dy = -reach; dy <= reach && !found; ++dy) {
@@ -206,13 +310,30 @@ void ScoreObstacles(const sim::ObstacleGrid& truth, const mapping::PointCloud& c
 
 }  // namespace
 
+RectifiedHead RectifiedHeadOf(const sim::StereoCameraOptions& camera) {
+  const std::optional<calib::StereoRectifier> r = calib::StereoRectifier::Create(
+      CameraModelOf(camera, camera.T_body_cam0), CameraModelOf(camera, camera.T_body_cam1()));
+  if (!r) throw std::invalid_argument("RectifiedHeadOf: the simulated head does not rectify");
+  RectifiedHead head;
+  head.stereo.width_px = r->image_size().width;
+  head.stereo.height_px = r->image_size().height;
+  head.stereo.focal_px = r->intrinsics().fx;
+  head.stereo.cx_px = r->intrinsics().cx;
+  head.stereo.cy_px = r->intrinsics().cy;
+  head.stereo.baseline_m = r->baseline_m();
+  head.stereo.Validate();
+  head.T_body_cam0rect = r->T_body_cam0rect();
+  return head;
+}
+
 MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
-                       const octomap::OcTree& map_world, const mapping::PointCloud& cloud_world,
+                       const sim::ObstacleRuleOptions& rule, const octomap::OcTree& map_world,
+                       const mapping::PointCloud& cloud_world,
                        const std::vector<Eigen::Isometry3d>& T_world_cameras,
-                       const MapQualityOptions& options) {
+                       const mapping::RectifiedStereo& head, const MapQualityOptions& options) {
   MapQuality q;
   ScoreOccupancy(world, map_world, options, &q);
-  ScoreObstacles(truth, cloud_world, T_world_cameras, options, &q);
+  ScoreObstacles(world, truth, rule, cloud_world, T_world_cameras, head, options, &q);
   return q;
 }
 

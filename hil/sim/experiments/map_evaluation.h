@@ -20,15 +20,25 @@
 // rock_min_height_m = h_max so that only rocks taller than a wheel can
 // climb count, plus steps and the top edges of drops):
 //  * precision = obstacle-flagged cloud points within `obstacle_radius_m`
-//    of a ground-truth obstacle cell / flagged points;
+//    of a ground-truth obstacle cell or of a tag carrier's footprint (a
+//    landmark post is an obstacle too, though not part of the heightfield)
+//    / flagged points;
 //  * recall = ground-truth obstacle cells with a flagged point within
 //    `obstacle_radius_m` / ground-truth obstacle cells that were observed:
 //    the map has a point within one cell of it, and the camera saw it from
 //    within `obstacle_view_range_m` (horizontal distance, inside the
-//    camera's horizontal field of view) at one of the given camera poses.
-//    Stereo error grows with the square of the distance, so obstacles only
-//    ever glimpsed at the far end of stereo range are not counted against
-//    the classifier; the rover has to find those it comes close to.
+//    camera's horizontal field of view) at one of the given camera poses,
+//    from where stereo resolves it. Stereo error grows with the square of
+//    the distance: an obstacle is resolved from a pose when its relief
+//    (the rock's height for a rock's cells, else the drop or the step the
+//    obstacle rule measured there) exceeds h_max by more than the stereo
+//    error of that
+//    height difference there (first order, the head's rectified geometry
+//    at `pixel_error_px`). A 0.48 m boulder is resolved at 4 m; a rock
+//    2.5 cm taller than h_max only within about 1.5 m on the simulator's
+//    head, and one only ever glimpsed farther away is not counted against
+//    the classifier, which cannot tell it from noise there. The rover has
+//    to find the obstacles it comes close to.
 
 #include <cstdint>
 #include <vector>
@@ -37,7 +47,9 @@
 
 #include <octomap/OcTree.h>
 
+#include "hil/sim/render/stereo_camera.h"
 #include "hil/sim/world/world.h"
+#include "mapping/depth/rectified_stereo.h"
 #include "mapping/submap/cloud_point.h"
 
 namespace rover::sim::experiments {
@@ -50,6 +62,8 @@ struct MapQualityOptions {
   double carrier_margin_m = 0.3;
   double obstacle_view_range_m = 4.0;
   double camera_half_fov_rad = 0.6;
+  /// Stereo matching error per image coordinate (thesis: 0.5 px).
+  double pixel_error_px = 0.5;
 };
 
 struct MapQuality {
@@ -67,14 +81,27 @@ struct MapQuality {
   double obstacle_recall = 0.0;
 };
 
+/// The simulated head as mapd sees it after rectification.
+struct RectifiedHead {
+  mapping::RectifiedStereo stereo;
+  Eigen::Isometry3d T_body_cam0rect = Eigen::Isometry3d::Identity();
+};
+
+/// Rectifies the simulated head's calibration as mapd does. Throws
+/// std::invalid_argument if that fails.
+RectifiedHead RectifiedHeadOf(const sim::StereoCameraOptions& camera);
+
 /// Scores `map_world` and `cloud_world` (CloudPoint::p_submap_m in world
-/// coordinates) against `world` and its obstacle grid `truth`.
-/// `T_world_cameras` are the left camera's true poses along the mission
-/// (for the obstacles' view range; OpenCV axes, z forward).
+/// coordinates) against `world` and its obstacle grid `truth` (computed
+/// with `rule`).
+/// `T_world_cameras` are the rectified left camera's true poses along the
+/// mission (for the obstacles' view range; OpenCV axes, z forward), `head`
+/// its rectified geometry.
 MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
-                       const octomap::OcTree& map_world, const mapping::PointCloud& cloud_world,
+                       const sim::ObstacleRuleOptions& rule, const octomap::OcTree& map_world,
+                       const mapping::PointCloud& cloud_world,
                        const std::vector<Eigen::Isometry3d>& T_world_cameras,
-                       const MapQualityOptions& options = {});
+                       const mapping::RectifiedStereo& head, const MapQualityOptions& options = {});
 
 }  // namespace rover::sim::experiments
 

@@ -114,18 +114,22 @@ double FractionNear(const octomap::OcTree& tree, double z_m, double tol_m) {
 
 TEST_F(MapdMappingTest, MapsPairsIntoSubmapsLogsThemAndExportsTheGlobalMap) {
   auto mapd = MakeMapd();
-  // Frame 0: the body stands at world x = 0.
+  // Frame 0: the body stands at world x = 0. Two pairs per frame: an
+  // obstacle is flagged once a second image confirms it.
   for (int i = 0; i <= 10; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
   Frame(mapd.get(), 1.05, 0.0, 1);
   for (int i = 11; i <= 20; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
   EXPECT_EQ(mapd->stats().images_mapped, 1u) << "mapped once its estimates arrived";
+  Frame(mapd.get(), 1.15, 0.0, 2);
+  EXPECT_EQ(mapd->stats().images_mapped, 2u);
   // The switch mapd asked for at start: frame 1 has its origin 0.5 m ahead,
   // so the same body position is x = -0.5 there.
   Switch(mapd.get(), 1.2, 0, 0.5);
   for (int i = 21; i <= 40; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 1, -0.5);
   Frame(mapd.get(), 1.30, 0.0, 3);
+  Frame(mapd.get(), 1.35, 0.0, 4);
   for (int i = 41; i <= 50; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 1, -0.5);
-  EXPECT_EQ(mapd->stats().images_mapped, 2u);
+  EXPECT_EQ(mapd->stats().images_mapped, 4u);
   EXPECT_EQ(mapd->stats().submaps_archived, 1u) << "frame 0's submap ends when frame 1 begins";
   mapd->Shutdown();
   EXPECT_EQ(mapd->stats().submaps_archived, 2u);

@@ -1,6 +1,7 @@
 // The stereo error model: analytic Jacobian against a numeric derivative of
 // the triangulation, the thesis's closed forms (eq. 5.2), and the distance
-// error (eq. 5.4, re-derived) against a seeded Monte Carlo.
+// error (eq. 5.4, re-derived) and the height difference's error against a
+// seeded Monte Carlo.
 
 #include "mapping/depth/stereo_error_model.h"
 
@@ -100,6 +101,47 @@ TEST(StereoErrorModelTest, DistanceSigmaMatchesAMonteCarloOfPixelNoise) {
   EXPECT_NEAR(model.DistanceSigma(p, q) / mc, 1.0, 0.05)
       << "first order " << model.DistanceSigma(p, q) << " m, Monte Carlo " << mc << " m";
   EXPECT_EQ(model.DistanceSigma(p, p), 0.0);
+}
+
+TEST(StereoErrorModelTest, HeightDifferenceSigmaMatchesAMonteCarloOfPixelNoise) {
+  const RectifiedStereo s = Head();
+  const double dp = 0.05;  // small, as above, so that first order holds
+  const StereoErrorModel model(s, dp);
+  // A camera 0.85 m above level ground, pitched 20 deg down (OpenCV axes:
+  // y down); two ground points 3.5 m ahead, 0.2 m apart across the line of
+  // sight (two cells of a height map side by side).
+  const double pitch = 20.0 * M_PI / 180.0;
+  const Eigen::Vector3d up_cam(0.0, -std::cos(pitch), -std::sin(pitch));
+  const Eigen::Vector3d forward_cam(0.0, -std::sin(pitch), std::cos(pitch));
+  const Eigen::Vector3d ground = 3.5 * forward_cam - 0.85 * up_cam;
+  const Eigen::Vector3d p = ground + Eigen::Vector3d(0.1, 0.0, 0.0);
+  const Eigen::Vector3d q = ground - Eigen::Vector3d(0.1, 0.0, 0.0);
+  const Eigen::Vector4d mp = ToImage(s, p), mq = ToImage(s, q);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, dp);
+  const double h0 = (p - q).dot(up_cam);
+  double sum_sq = 0.0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector4d np = mp, nq = mq;
+    for (int k = 0; k < 4; ++k) {
+      np[k] += noise(rng);
+      nq[k] += noise(rng);
+    }
+    const double h = (FromImage(s, np) - FromImage(s, nq)).dot(up_cam);
+    sum_sq += (h - h0) * (h - h0);
+  }
+  const double mc = std::sqrt(sum_sq / n);
+  const double sigma = model.HeightDifferenceSigma(p, q, up_cam);
+  EXPECT_NEAR(sigma / mc, 1.0, 0.05) << "first order " << sigma << " m, Monte Carlo " << mc;
+  // Side by side across the line of sight, the distance between the two
+  // points hardly sees the depth error that moves both heights: the
+  // thesis's Delta d is several times smaller than the height difference's
+  // error here.
+  EXPECT_LT(model.DistanceSigma(p, q), 0.3 * sigma);
+  // Stacked vertically, both are the same quantity.
+  const Eigen::Vector3d top = p + 0.2 * up_cam;
+  EXPECT_NEAR(model.DistanceSigma(top, p), model.HeightDifferenceSigma(top, p, up_cam), 1e-12);
 }
 
 TEST(StereoErrorModelTest, RejectsUnusableGeometry) {

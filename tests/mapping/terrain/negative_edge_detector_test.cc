@@ -53,6 +53,37 @@ TEST(NegativeEdgeDetectorTest, GroundDroppingOutOfStereoRangeIsAnEdge) {
   }
 }
 
+TEST(NegativeEdgeDetectorTest, AWrongMatchAlongASteepRayIsNoEdge) {
+  // Level ground; one column's disparity at 1.5 m ahead made 15 % too small
+  // over a few rows (a wrong match: 0.35 m farther along its ray). The ray
+  // is steeper than 25 degrees, so the jump passes eq. 5.1's slope test;
+  // only its size tells it from a drop: on this head (f = 115 px) sigma_z
+  // is about 0.2 m there, the fixed 0.2 m threshold takes it, the one with
+  // the stereo error (0.5 m) does not. A 1 m drop at the same place stays
+  // an edge.
+  const RectifiedStereo s = SmallHead();
+  const StereoErrorModel model(s);
+  const Eigen::Isometry3d T = CameraPose(1.0, 25.0);
+  cv::Mat disparity = RenderDisparity(s, T, [](double, double) { return 0.0; });
+  const int u = s.width_px / 2;
+  int v_hit = -1;  // the nearest row beyond 1.5 m (rows run from far to near)
+  for (int v = s.height_px - 1; v >= 0 && v_hit < 0; --v) {
+    const Eigen::Vector3d p = T * s.Triangulate(u, v, disparity.at<int16_t>(v, u) / 16.0);
+    if (disparity.at<int16_t>(v, u) > 0 && p.x() > 1.5) v_hit = v;
+  }
+  ASSERT_GT(v_hit, 3);
+  for (int v = v_hit - 3; v < v_hit; ++v) {
+    disparity.at<int16_t>(v, u) = static_cast<int16_t>(disparity.at<int16_t>(v, u) * 17 / 20);
+  }
+  const DepthImage depth = DepthImage::FromDisparity(disparity, model, {.max_depth_sigma_m = 1.0});
+  EXPECT_FALSE(NegativeEdgeDetector({.error_adaptive = false}).Detect(depth, T).empty());
+  EXPECT_TRUE(NegativeEdgeDetector({}).Detect(depth, T).empty());
+  const DepthImage drop = DepthImage::FromDisparity(
+      RenderDisparity(s, T, [](double x, double) { return x < 1.5 ? 0.0 : -1.0; }), model,
+      {.max_depth_sigma_m = 1.0});
+  EXPECT_FALSE(NegativeEdgeDetector({}).Detect(drop, T).empty());
+}
+
 TEST(NegativeEdgeDetectorTest, RejectsBadOptions) {
   EXPECT_THROW(NegativeEdgeDetector({.depth_jump_m = 0.0}), std::invalid_argument);
   EXPECT_THROW(NegativeEdgeDetector({.max_slope_deg = 90.0}), std::invalid_argument);

@@ -55,26 +55,27 @@ TEST(StepClassifierTest, ARockIsAnObstacleAndLevelGroundIsNot) {
 }
 
 TEST(StepClassifierTest, TheErrorAdaptiveThresholdGrowsWithDistance) {
-  // A 0.15 m step (over h_max = 0.1 m). 4 m ahead, the distance error of
-  // the thesis's 0.5 px at half the simulator's resolution is several cm:
-  // the adaptive threshold does not call it (stereo cannot tell it from
-  // noise there), a fixed one does. 1.6 m ahead both call it.
-  const auto far_step = [](double x, double) { return x > 4.0 ? 0.15 : 0.0; };
-  const auto near_step = [](double x, double) { return x > 1.6 ? 0.15 : 0.0; };
+  // A 0.2 m step (over h_max = 0.1 m) on this half-resolution head (f =
+  // 230 px, b = 0.11 m). 4 m ahead the stereo error of the height
+  // difference across it (thesis: 0.5 px) is about 0.14 m: the adaptive
+  // threshold does not call it (stereo cannot tell it from noise there), a
+  // fixed one does. 1.4 m ahead (error about 0.05 m) both call it.
+  const auto far_step = [](double x, double) { return x > 4.0 ? 0.2 : 0.0; };
+  const auto near_step = [](double x, double) { return x > 1.4 ? 0.2 : 0.0; };
   const int adaptive_far = CountObstacles(Classify(far_step, true), 3.7, 4.3, -9, 9).first;
   const int fixed_far = CountObstacles(Classify(far_step, false), 3.7, 4.3, -9, 9).first;
   EXPECT_GT(fixed_far, 20);
   // At most a stray cell where the median filter meets the end of the data.
   EXPECT_LE(adaptive_far, 1) << "fixed threshold: " << fixed_far;
-  EXPECT_GT(CountObstacles(Classify(near_step, true), 1.4, 1.8, -9, 9).first, 0);
+  EXPECT_GT(CountObstacles(Classify(near_step, true), 1.2, 1.6, -9, 9).first, 0);
 }
 
 TEST(HeightMapTest, SpikeRemovalDropsALoneSpikeButKeepsAStep) {
   // Level ground with one cell's points lifted 0.5 m (wrong matches that
-  // landed together), and a real 0.15 m step further on.
+  // landed together), and a real 0.25 m step further on.
   const auto terrain = [](double x, double y) {
     if (x > 1.5 && x < 1.55 && y > 0.0 && y < 0.05) return 0.5;
-    return x > 2.1 ? 0.15 : 0.0;
+    return x > 2.1 ? 0.25 : 0.0;
   };
   const auto spike_obstacles = [&](bool remove_spikes) {
     const RectifiedStereo s = SmallHead(2);
