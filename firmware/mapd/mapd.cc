@@ -126,6 +126,7 @@ void MapdOptions::Validate() const {
   }
   local_mapper.Validate();
   submap.Validate();
+  loop.Validate();
 }
 
 Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
@@ -162,6 +163,9 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
   if (options_.slam) {
     slam_ = std::make_unique<SlamWorker>(options_.graph, options_.robot_id);
     LoadResumeCandidate();
+    if (options_.mapping && options_.loop_closures) {
+      loop_ = std::make_unique<LoopCloser>(options_.loop, options_.robot_id);
+    }
   }
   trigger_.RequestAtNextPose();
 }
@@ -195,6 +199,7 @@ int Mapd::Poll() {
     ++handled;
   }
   TryMapPending();
+  if (loop_) TakeLoopMatches();
   if (slam_) TakeSlamSnapshot();
   if (poses_->HasMissedData()) ++stats_.missed;
   if (frames_->HasMissedData()) ++stats_.missed;
@@ -451,6 +456,8 @@ void Mapd::FinishMappingSubmap() {
     stats_.octree_bytes += bytes.octree;
     stats_.cloud_bytes += bytes.cloud;
     ++stats_.submaps_archived;
+    // The loop closer owns it from here until its matching data is built.
+    if (loop_) loop_->AddSubmap(std::shared_ptr<const mapping::Submap>(std::move(mapping_submap_)));
   }
   mapping_submap_.reset();
 }
@@ -545,6 +552,26 @@ void Mapd::LogAndSubmit(const log::rover_msgs::GraphFactor& msg) {
   }
 }
 
+void Mapd::TakeLoopMatches() {
+  for (const std::string& problem : loop_->TakeProblems()) {
+    std::fprintf(stderr, "mapd: %s\n", problem.c_str());
+  }
+  for (const LoopMatch& m : loop_->TakeMatches()) {
+    if (!m.accepted) continue;
+    mapping::GraphFactorRecord factor = mapping::SubmapMatchFactor(
+        mapping::GraphKey::Origin(m.a.robot, m.a.index),
+        mapping::GraphKey::Origin(m.b.robot, m.b.index), m.T_a_b, m.covariance);
+    // The match holds from when the later of the two submaps was finished.
+    for (const SubmapRecord& r : submaps_) {
+      if (r.frame_id == m.a.index || r.frame_id == m.b.index) {
+        factor.stamp_ns = std::max(factor.stamp_ns, r.last_stamp.nanoseconds());
+      }
+    }
+    AddFactor(std::move(factor));
+    ++stats_.loop_closures;
+  }
+}
+
 void Mapd::TakeSlamSnapshot() {
   for (const std::string& problem : slam_->TakeProblems()) {
     std::fprintf(stderr, "mapd: pose graph: %s\n", problem.c_str());
@@ -569,6 +596,7 @@ void Mapd::TakeSlamSnapshot() {
     origins.origins.push_back(m);
   }
   archive_->SetOrigins(T_world_frame);
+  if (loop_) loop_->UpdateOrigins(snap.origins);
   std::optional<log::geometry_msgs::PoseWithCovarianceStamped> pose;
   if (snap.T_world_body) {
     pose.emplace();
@@ -599,6 +627,12 @@ MapdBandwidth Mapd::Bandwidth() const {
 void Mapd::Shutdown() {
   if (shut_down_) return;
   shut_down_ = true;
+  if (archive_) FinishMappingSubmap();
+  if (loop_) {
+    // Every submap gets its chance at a loop closure before the final graph.
+    loop_->Flush();
+    TakeLoopMatches();
+  }
   if (slam_) {
     HandLatestPose();  // the run's final global pose is the last estimate's
     slam_->Flush();
@@ -617,6 +651,19 @@ void Mapd::Shutdown() {
     if (!g.update_ms.empty()) {
       graph["graph_update_ms_p50"] = std::to_string(stats::Percentile(g.update_ms, 50.0));
       graph["graph_update_ms_p99"] = std::to_string(stats::Percentile(g.update_ms, 99.0));
+    }
+  }
+  if (loop_) {
+    const LoopCloserStats l = loop_->Stats();
+    graph["loop_submaps_suitable"] = std::to_string(l.submaps_suitable);
+    graph["loop_pairs_matched"] = std::to_string(l.pairs_matched);
+    graph["loop_closures"] = std::to_string(stats_.loop_closures);
+    if (!l.match_ms.empty()) {
+      graph["matcher_ms_p50"] = std::to_string(stats::Percentile(l.match_ms, 50.0));
+      graph["matcher_ms_p99"] = std::to_string(stats::Percentile(l.match_ms, 99.0));
+    }
+    if (!l.data_ms.empty()) {
+      graph["match_data_ms_p50"] = std::to_string(stats::Percentile(l.data_ms, 50.0));
     }
   }
   std::map<std::string, std::string> statistics = {
@@ -687,6 +734,20 @@ std::string Mapd::Summary() const {
                   static_cast<unsigned long long>(g.updates),
                   static_cast<unsigned long long>(g.solves),
                   static_cast<unsigned long long>(g.update_errors), p50, p99);
+    out += text;
+  }
+  if (loop_) {
+    const LoopCloserStats l = loop_->Stats();
+    const double data_p50 = l.data_ms.empty() ? 0.0 : stats::Percentile(l.data_ms, 50.0);
+    const double match_p50 = l.match_ms.empty() ? 0.0 : stats::Percentile(l.match_ms, 50.0);
+    char text[240];
+    std::snprintf(text, sizeof(text),
+                  "  loop closures: %llu accepted of %llu pairs matched; %llu of %llu submaps "
+                  "suitable (data %.0f ms p50); match %.0f ms p50\n",
+                  static_cast<unsigned long long>(stats_.loop_closures),
+                  static_cast<unsigned long long>(l.pairs_matched),
+                  static_cast<unsigned long long>(l.submaps_suitable),
+                  static_cast<unsigned long long>(l.submaps), data_p50, match_p50);
     out += text;
   }
   char line[200];

@@ -29,6 +29,7 @@
 #include "core/ipc/transport.h"
 #include "core/time/time.h"
 #include "firmware/mapd/local_mapper.h"
+#include "firmware/mapd/loop_closer.h"
 #include "firmware/mapd/pose_history.h"
 #include "firmware/mapd/slam_worker.h"
 #include "firmware/mapd/submap_trigger.h"
@@ -75,6 +76,10 @@ struct MapdOptions {
   int robot_id = 0;
   /// Wall time between global-pose updates handed to the graph thread.
   Duration global_pose_period = Duration::Milliseconds(200);
+  /// Find loop closures by matching finished submaps (needs mapping and
+  /// slam); accepted matches join the graph as c factors.
+  bool loop_closures = true;
+  LoopCloserOptions loop{};
 
   /// Throws std::invalid_argument naming the key.
   void Validate() const;
@@ -116,6 +121,7 @@ struct MapdStats {
   uint64_t grids_published = 0;
   uint64_t graph_factors_refused = 0;  ///< malformed before reaching the graph (NaN, ...)
   uint64_t graph_factors_resumed = 0;  ///< taken over from the previous mapd's log
+  uint64_t loop_closures = 0;          ///< accepted matches added to the graph
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
@@ -149,6 +155,8 @@ class Mapd {
   const MapdStats& stats() const { return stats_; }
   /// The pose graph's counters (empty without slam).
   SlamStats slam_stats() const { return slam_ ? slam_->Stats() : SlamStats{}; }
+  /// The loop closer's counters (empty without loop closures).
+  LoopCloserStats loop_stats() const { return loop_ ? loop_->Stats() : LoopCloserStats{}; }
   /// The latest graph snapshot (update 0 without slam).
   SlamSnapshot slam_snapshot() const { return slam_ ? slam_->Latest() : SlamSnapshot{}; }
 
@@ -197,6 +205,8 @@ class Mapd {
   void TakeSlamSnapshot();
   /// Hands the newest estimate to the graph thread for the global pose.
   void HandLatestPose();
+  /// Adds the loop closer's accepted matches to the graph.
+  void TakeLoopMatches();
 
   MapdOptions options_;
   SubmapTrigger trigger_;
@@ -219,6 +229,7 @@ class Mapd {
   std::optional<Time> last_mapped_capture_;
   std::optional<Time> last_traversability_;
   std::unique_ptr<SlamWorker> slam_;
+  std::unique_ptr<LoopCloser> loop_;
   bool prior_added_ = false;
   uint64_t next_factor_id_ = 1;
   uint64_t last_snapshot_update_ = 0;

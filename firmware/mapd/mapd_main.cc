@@ -43,7 +43,10 @@ int main(int argc, char** argv) {
       "unit), starts a new submap when the filter's position sigma or the distance driven in\n"
       "the current one exceeds its limit, and asks roverd for the frame switch that gives it\n"
       "its origin. Maps the stereo pairs (SGBM depth, obstacle classification, 10 cm OctoMap\n"
-      "and 5 cm cloud per submap) into OUT/mapd-<time>-<pid>.mcap. Stops on SIGTERM or SIGINT,\n"
+      "and 5 cm cloud per submap) into OUT/mapd-<time>-<pid>.mcap. In threads below its own\n"
+      "priority it matches finished submaps (4D: x, y, z, yaw) for loop closures and optimises\n"
+      "the pose graph (frame switches and matches), logging every factor as it is added; the\n"
+      "global map sits at the optimised origins. Stops on SIGTERM or SIGINT,\n"
       "then writes the global map beside the log (.bt, .ot for octovis; .ply) and prints its\n"
       "submaps.\n"};
   rover::mapd::MapdOptions options;
@@ -73,6 +76,13 @@ int main(int argc, char** argv) {
                  "pairs mapped per second of capture time at most (0: all mapd keeps up with)")
       ->capture_default_str();
   app.add_option("--robot", options.robot_name, "robot name in frame ids (default: board.name)");
+  bool no_loop_closures = false;
+  app.add_flag("--no-loop-closures", no_loop_closures,
+               "match no submaps: the pose graph holds only the filter's frame switches");
+  bool match_6d = false;
+  app.add_flag("--match-6d", match_6d,
+               "match submaps with the 6D baseline (6D RANSAC and ICP) instead of the 4D "
+               "matcher that uses the submaps' gravity alignment");
   CLI11_PARSE(app, argc, argv);
   if (!config.empty()) {
     try {
@@ -96,6 +106,8 @@ int main(int argc, char** argv) {
     }
   }
   if (no_mapping) options.mapping = false;
+  if (no_loop_closures) options.loop_closures = false;
+  if (match_6d) options.loop.matcher.mode = rover::mapping::MatchMode::kSixDof;
   if (!out_dir.empty() && options.mapping) {
     options.output_stem = (std::filesystem::path(out_dir) / LogStem()).string();
   }

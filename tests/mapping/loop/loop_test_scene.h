@@ -212,13 +212,14 @@ struct SyntheticSubmap {
   Eigen::Isometry3d T_world_submap = Eigen::Isometry3d::Identity();
 };
 
-/// Renders the drive into a finished submap in the frame of its first pose.
+/// Renders the drive into a finished submap in the frame of its first pose;
+/// the submap is `frame_id`'s (index and frame id).
 inline SyntheticSubmap BuildSubmap(const LoopWorld& world,
                                    const std::vector<Eigen::Isometry3d>& cams, uint64_t seed,
-                                   const RenderSettings& s = {}) {
+                                   const RenderSettings& s = {}, uint32_t frame_id = 0) {
   SyntheticSubmap out;
   out.T_world_submap = SubmapFrameAt(cams.front());
-  out.submap = std::make_unique<Submap>(0, 0, SubmapOptions{});
+  out.submap = std::make_unique<Submap>(frame_id, frame_id, SubmapOptions{});
   std::mt19937_64 rng(seed);
   DepthImage depth;
   std::vector<uint8_t> mask;

@@ -1,0 +1,248 @@
+#include "firmware/mapd/loop_closer.h"
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <stdexcept>
+
+namespace rover::mapd {
+namespace {
+
+void LowerPriority(int increment) {
+  setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), increment);
+}
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+bool FiniteCovariance(const mapping::Matrix6d& c) { return c.allFinite(); }
+
+}  // namespace
+
+void LoopCloserOptions::Validate() const {
+  data.Validate();
+  pairing.Validate();
+  matcher.Validate();
+  if (max_queued_pairs < 1 || max_queued_pairs > 1000) {
+    throw std::invalid_argument("LoopCloserOptions.max_queued_pairs: expected 1..1000, found " +
+                                std::to_string(max_queued_pairs));
+  }
+  if (nice_increment < 0 || nice_increment > 19) {
+    throw std::invalid_argument("LoopCloserOptions.nice_increment: expected 0..19, found " +
+                                std::to_string(nice_increment));
+  }
+}
+
+LoopCloserOptions LoopCloserOptions::Load(const ConfigNode& node) {
+  LoopCloserOptions o;
+  if (node.Has("data")) o.data = mapping::SubmapMatchDataOptions::Load(node.Child("data"));
+  if (node.Has("pairing")) o.pairing = mapping::SubmapPairingOptions::Load(node.Child("pairing"));
+  if (node.Has("matcher")) o.matcher = mapping::SubmapMatcherOptions::Load(node.Child("matcher"));
+  o.max_queued_pairs = node.Get<int>("max_queued_pairs", o.max_queued_pairs);
+  o.nice_increment = node.Get<int>("nice_increment", o.nice_increment);
+  o.Validate();
+  return o;
+}
+
+LoopCloser::LoopCloser(const LoopCloserOptions& options, int robot)
+    : options_((options.Validate(), options)),
+      robot_(robot),
+      matcher_(options.matcher),
+      pairing_(options.pairing),
+      pairing_thread_([this] { RunPairing(); }),
+      matching_thread_([this] { RunMatching(); }) {}
+
+LoopCloser::~LoopCloser() { Stop(); }
+
+void LoopCloser::AddSubmap(std::shared_ptr<const mapping::Submap> submap) {
+  if (!submap) return;
+  {
+    const std::lock_guard lock(mutex_);
+    waiting_.push_back(std::move(submap));
+    ++stats_.submaps;
+  }
+  wake_pairing_.notify_all();
+}
+
+void LoopCloser::UpdateOrigins(const std::map<int64_t, OptimisedOrigin>& origins) {
+  {
+    const std::lock_guard lock(mutex_);
+    origins_ = origins;
+    origins_changed_ = true;
+  }
+  wake_pairing_.notify_all();
+}
+
+std::vector<LoopMatch> LoopCloser::TakeMatches() {
+  const std::lock_guard lock(mutex_);
+  std::vector<LoopMatch> out;
+  out.swap(done_);
+  return out;
+}
+
+std::vector<std::string> LoopCloser::TakeProblems() {
+  const std::lock_guard lock(mutex_);
+  std::vector<std::string> out;
+  out.swap(problems_);
+  return out;
+}
+
+LoopCloserStats LoopCloser::Stats() const {
+  const std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+bool LoopCloser::PairingIdle() const {
+  return waiting_.empty() && !preparing_ && !origins_changed_ && !slot_freed_ && queue_.empty() &&
+         !matching_;
+}
+
+void LoopCloser::Flush() {
+  std::unique_lock lock(mutex_);
+  idle_.wait(lock, [&] { return stop_ || PairingIdle(); });
+}
+
+void LoopCloser::Stop() {
+  {
+    const std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_pairing_.notify_all();
+  wake_matching_.notify_all();
+  idle_.notify_all();
+  if (pairing_thread_.joinable()) pairing_thread_.join();
+  if (matching_thread_.joinable()) matching_thread_.join();
+}
+
+void LoopCloser::RunPairing() {
+  LowerPriority(options_.nice_increment);
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_pairing_.wait(
+        lock, [&] { return stop_ || !waiting_.empty() || origins_changed_ || slot_freed_; });
+    if (stop_) return;
+    slot_freed_ = false;
+    PrepareWaiting(&lock);
+    if (stop_) return;
+    SyncPairing();
+    QueuePairs();
+    if (PairingIdle()) idle_.notify_all();
+  }
+}
+
+void LoopCloser::PrepareWaiting(std::unique_lock<std::mutex>* lock) {
+  while (!waiting_.empty() && !stop_) {
+    std::shared_ptr<const mapping::Submap> submap = std::move(waiting_.front());
+    waiting_.pop_front();
+    preparing_ = true;
+    lock->unlock();
+    std::shared_ptr<const mapping::SubmapMatchData> data;
+    std::string problem;
+    try {
+      data = mapping::SubmapMatchData::Build(submap->cloud(), submap->octree(), options_.data);
+    } catch (const std::exception& e) {
+      problem = "loop closures: submap " + std::to_string(submap->frame_id()) +
+                " has no matching data: " + e.what();
+    }
+    const int64_t frame = submap->frame_id();
+    submap.reset();  // the octree and cloud are no longer needed here
+    lock->lock();
+    preparing_ = false;
+    if (!data) {
+      ++stats_.submaps_failed;
+      problems_.push_back(std::move(problem));
+      continue;
+    }
+    stats_.data_ms.push_back(data->build_ms());
+    if (data->suitable()) ++stats_.submaps_suitable;
+    prepared_[frame] = Prepared{data, false, false};
+  }
+}
+
+void LoopCloser::SyncPairing() {
+  const bool changed = origins_changed_;
+  origins_changed_ = false;
+  for (auto& [frame, p] : prepared_) {
+    const auto origin = origins_.find(frame);
+    if (origin == origins_.end() || !FiniteCovariance(origin->second.covariance)) continue;
+    const mapping::SubmapId id{robot_, frame};
+    if (!p.paired) {
+      p.paired = true;
+      try {
+        pairing_.AddSubmap(id, *p.data, origin->second.T_world_origin, origin->second.covariance);
+        p.in_pairing = true;
+      } catch (const std::exception& e) {
+        problems_.push_back("loop closures: submap " + std::to_string(frame) +
+                            " left out of the pairing: " + e.what());
+      }
+      // The pairing keeps what it needs of an unsuitable submap.
+      if (!p.in_pairing || !p.data->suitable()) p.data.reset();
+    } else if (changed && p.in_pairing) {
+      try {
+        pairing_.UpdateOrigin(id, origin->second.T_world_origin, origin->second.covariance);
+      } catch (const std::exception& e) {
+        problems_.push_back("loop closures: origin " + std::to_string(frame) +
+                            " not updated: " + e.what());
+      }
+    }
+  }
+}
+
+void LoopCloser::QueuePairs() {
+  while (queue_.size() < static_cast<std::size_t>(options_.max_queued_pairs)) {
+    std::optional<mapping::SubmapPair> next = pairing_.Next();
+    if (!next) break;
+    const auto a = prepared_.find(next->a.index);
+    const auto b = prepared_.find(next->b.index);
+    if (a == prepared_.end() || b == prepared_.end() || !a->second.data || !b->second.data) {
+      continue;  // another robot's submap: not matched here
+    }
+    queue_.push_back(QueuedPair{*next, a->second.data, b->second.data});
+  }
+  if (!queue_.empty()) wake_matching_.notify_all();
+}
+
+void LoopCloser::RunMatching() {
+  LowerPriority(options_.nice_increment);
+  std::unique_lock lock(mutex_);
+  while (true) {
+    wake_matching_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+    if (stop_) return;
+    QueuedPair job = std::move(queue_.front());
+    queue_.pop_front();
+    matching_ = true;
+    lock.unlock();
+    const auto start = std::chrono::steady_clock::now();
+    LoopMatch m;
+    m.a = job.pair.a;
+    m.b = job.pair.b;
+    m.prior = job.pair.prior;
+    try {
+      const mapping::SubmapMatchResult r = matcher_.Match(*job.a, *job.b, job.pair.prior);
+      m.accepted = r.accepted;
+      m.rejection = r.rejection;
+      m.T_a_b = r.T_a_b;
+      m.covariance = r.covariance;
+      m.inliers = static_cast<int>(r.inliers.size());
+      m.rmse_m = r.icp.rmse_m;
+    } catch (const std::exception& e) {
+      m.rejection = std::string("matcher failed: ") + e.what();
+    }
+    m.match_ms = MsSince(start);
+    lock.lock();
+    matching_ = false;
+    ++stats_.pairs_matched;
+    if (m.accepted) ++stats_.matches_accepted;
+    stats_.match_ms.push_back(m.match_ms);
+    done_.push_back(std::move(m));
+    slot_freed_ = true;
+    wake_pairing_.notify_all();
+    if (PairingIdle()) idle_.notify_all();
+  }
+}
+
+}  // namespace rover::mapd

@@ -1,0 +1,156 @@
+#ifndef ROVER_FIRMWARE_MAPD_LOOP_CLOSER_H_
+#define ROVER_FIRMWARE_MAPD_LOOP_CLOSER_H_
+
+// mapd's loop closures by submap matching (thesis 6.1), in two threads
+// below mapd's normal priority:
+//   pairing   takes each finished submap, computes its matching data once
+//             (keypoints, descriptors, k-d trees; SubmapMatchData), adds it
+//             to the SubmapPairing with the graph's current origin estimate,
+//             follows the graph's updates, and hands the best candidate
+//             pairs to the matcher, each pair once;
+//   matching  runs the 4D matcher (or the 6D baseline) on one pair at a time.
+// mapd's main loop takes the results (TakeMatches) and adds the accepted
+// ones to the pose graph as c factors; loop closures never reach the filter.
+// A submap's matching data outlives the submap itself (mapd drops the
+// octree once it is archived); the data of a submap the pairing refused as
+// unsuitable is dropped at once.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/config/config.h"
+#include "firmware/mapd/slam_worker.h"
+#include "mapping/loop/submap_match_data.h"
+#include "mapping/loop/submap_matcher.h"
+#include "mapping/loop/submap_pairing.h"
+#include "mapping/submap/submap.h"
+
+namespace rover::mapd {
+
+struct LoopCloserOptions {
+  mapping::SubmapMatchDataOptions data{};
+  mapping::SubmapPairingOptions pairing{};
+  mapping::SubmapMatcherOptions matcher{};
+  /// Pairs waiting for the matching thread at most; the pairing hands out
+  /// the next best pair only once the queue has room, so a graph update in
+  /// between can still reorder (or drop) the candidates.
+  int max_queued_pairs = 2;
+  /// Nice increment of both threads over mapd's main loop.
+  int nice_increment = 10;
+
+  /// Throws std::invalid_argument naming the key.
+  void Validate() const;
+  /// Keys: data, pairing, matcher (child maps, as their Load), and the
+  /// fields above (all optional).
+  static LoopCloserOptions Load(const ConfigNode& node);
+};
+
+/// One matched pair, accepted or not.
+struct LoopMatch {
+  mapping::SubmapId a;
+  mapping::SubmapId b;
+  /// The prior the pairing gave (T_a_b from the origin estimates).
+  mapping::MatchPrior prior;
+  bool accepted = false;
+  std::string rejection;  ///< empty when accepted
+  Eigen::Isometry3d T_a_b = Eigen::Isometry3d::Identity();
+  mapping::Matrix6d covariance = mapping::Matrix6d::Identity();
+  int inliers = 0;
+  double rmse_m = 0.0;
+  double match_ms = 0.0;
+};
+
+/// Counters so far.
+struct LoopCloserStats {
+  uint64_t submaps = 0;           ///< handed over
+  uint64_t submaps_suitable = 0;  ///< whose matching data passed the suitability checks
+  uint64_t submaps_failed = 0;    ///< matching data could not be computed (message in problems)
+  uint64_t pairs_matched = 0;
+  uint64_t matches_accepted = 0;
+  std::vector<double> data_ms;   ///< per submap
+  std::vector<double> match_ms;  ///< per matched pair
+};
+
+class LoopCloser {
+ public:
+  /// Starts both threads; `robot` is this rover's id (SubmapId::robot).
+  /// Throws std::invalid_argument for invalid options.
+  LoopCloser(const LoopCloserOptions& options, int robot);
+  ~LoopCloser();
+  LoopCloser(const LoopCloser&) = delete;
+  LoopCloser& operator=(const LoopCloser&) = delete;
+
+  /// Hands over a finished submap; its matching data is computed in the
+  /// pairing thread, which keeps `submap` only until then.
+  void AddSubmap(std::shared_ptr<const mapping::Submap> submap);
+  /// The graph's origin estimates after an update (this robot's, by local
+  /// frame id). A submap joins the pairing once its origin is known.
+  void UpdateOrigins(const std::map<int64_t, OptimisedOrigin>& origins);
+  /// Matches finished since the last call, in the order they finished.
+  std::vector<LoopMatch> TakeMatches();
+  /// Messages (submaps whose data failed) since the last call.
+  std::vector<std::string> TakeProblems();
+  LoopCloserStats Stats() const;
+  /// Waits until every submap handed over has its data and every candidate
+  /// pair the current origins give has been matched (tests, end of a run).
+  void Flush();
+  /// Stops both threads (idempotent; the destructor calls it).
+  void Stop();
+
+ private:
+  struct Prepared {
+    std::shared_ptr<const mapping::SubmapMatchData> data;
+    bool paired = false;      ///< tried to add to the pairing
+    bool in_pairing = false;  ///< added
+  };
+  void RunPairing();
+  void RunMatching();
+  /// Pairing thread, lock held on entry and exit: computes the data of
+  /// every waiting submap (unlocked while it works).
+  void PrepareWaiting(std::unique_lock<std::mutex>* lock);
+  /// Pairing thread, lock held: adds prepared submaps whose origin is now
+  /// known, applies new origins.
+  void SyncPairing();
+  /// Pairing thread, lock held: moves candidates into the match queue.
+  void QueuePairs();
+  bool PairingIdle() const;
+
+  const LoopCloserOptions options_;
+  const int robot_;
+  const mapping::SubmapMatcher matcher_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_pairing_;
+  std::condition_variable wake_matching_;
+  std::condition_variable idle_;
+  std::deque<std::shared_ptr<const mapping::Submap>> waiting_;
+  bool preparing_ = false;
+  std::map<int64_t, OptimisedOrigin> origins_;
+  bool origins_changed_ = false;
+  mapping::SubmapPairing pairing_;
+  std::map<int64_t, Prepared> prepared_;  ///< by frame id
+  struct QueuedPair {
+    mapping::SubmapPair pair;
+    std::shared_ptr<const mapping::SubmapMatchData> a;
+    std::shared_ptr<const mapping::SubmapMatchData> b;
+  };
+  std::deque<QueuedPair> queue_;
+  bool matching_ = false;
+  bool slot_freed_ = false;  ///< a match finished: the pairing may queue the next
+  std::vector<LoopMatch> done_;
+  std::vector<std::string> problems_;
+  LoopCloserStats stats_;
+  bool stop_ = false;
+  std::thread pairing_thread_;  // last two: started once everything above exists
+  std::thread matching_thread_;
+};
+
+}  // namespace rover::mapd
+
+#endif  // ROVER_FIRMWARE_MAPD_LOOP_CLOSER_H_

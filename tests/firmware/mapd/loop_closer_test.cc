@@ -1,0 +1,202 @@
+// mapd's loop closer on synthetic submaps (tests/mapping/loop/loop_test_scene.h:
+// rocks on sloped ground, stereo noise growing with range): a revisit is
+// matched once its origin estimate is known and found close to the truth
+// despite the drift in the estimates, successive and far-apart submaps are
+// never paired, a submap without structure is counted as unsuitable, and
+// stopping with work queued returns.
+
+#include "firmware/mapd/loop_closer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "tests/mapping/loop/loop_test_scene.h"
+
+namespace rover::mapd {
+namespace {
+
+using mapping::testing::LoopWorld;
+using mapping::testing::SyntheticSubmap;
+
+constexpr double kDeg = M_PI / 180.0;
+
+SyntheticSubmap Drive(const LoopWorld& world, const Eigen::Vector2d& start, double yaw,
+                      uint64_t seed, uint32_t frame) {
+  return mapping::testing::BuildSubmap(
+      world, mapping::testing::StraightDrive(world, start, yaw, 12, 0.5), seed, {}, frame);
+}
+
+// The origin estimate: the truth moved by the drift, with a covariance that
+// covers it.
+OptimisedOrigin Estimate(const Eigen::Isometry3d& truth, const Eigen::Vector3d& drift_m,
+                         double drift_yaw_rad, double sigma_m, double sigma_yaw_rad) {
+  OptimisedOrigin o;
+  o.T_world_origin = truth * GravityAlignedTransform(drift_m, drift_yaw_rad);
+  o.covariance.setZero();
+  o.covariance.diagonal() << sigma_m * sigma_m, sigma_m * sigma_m, sigma_m * sigma_m, 1e-6, 1e-6,
+      sigma_yaw_rad * sigma_yaw_rad;
+  return o;
+}
+
+// The drives: frame 1 and its revisit 3 cover the first rock field; 2
+// drives through the second field in between.
+struct DriveSpec {
+  Eigen::Vector2d start;
+  double yaw_rad;
+  uint64_t seed;
+};
+const std::map<uint32_t, DriveSpec>& Drives() {
+  static const std::map<uint32_t, DriveSpec> drives = {
+      {1, {{0.0, 0.0}, 0.0, 11}}, {2, {{0.0, 40.0}, 0.0, 12}}, {3, {{1.0, 0.5}, 0.2, 13}}};
+  return drives;
+}
+
+class LoopCloserTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    world_ = new LoopWorld;
+    mapping::testing::ScatterRocks(-2, 22, -8, 8, 0.25, 1, world_);
+    mapping::testing::ScatterRocks(-2, 22, 32, 48, 0.25, 2, world_);
+  }
+  static void TearDownTestSuite() { delete world_; }
+
+  static SyntheticSubmap Render(uint32_t frame) {
+    const DriveSpec& d = Drives().at(frame);
+    return Drive(*world_, d.start, d.yaw_rad, d.seed, frame);
+  }
+
+  static Eigen::Isometry3d Truth(uint32_t frame) {
+    const DriveSpec& d = Drives().at(frame);
+    return mapping::testing::SubmapFrameAt(
+        mapping::testing::StraightDrive(*world_, d.start, d.yaw_rad, 12, 0.5).front());
+  }
+
+  // Origins as the graph would give them after some drift: frame 1 exact,
+  // the later ones off by up to 0.3 m and 2 deg.
+  static std::map<int64_t, OptimisedOrigin> DriftedOrigins() {
+    std::map<int64_t, OptimisedOrigin> origins;
+    origins[1] = Estimate(Truth(1), {0, 0, 0}, 0.0, 0.01, 0.1 * kDeg);
+    origins[2] = Estimate(Truth(2), {0.1, -0.1, 0.0}, 1.0 * kDeg, 0.3, 1.5 * kDeg);
+    origins[3] = Estimate(Truth(3), {0.3, -0.2, 0.05}, 2.0 * kDeg, 0.5, 3.0 * kDeg);
+    return origins;
+  }
+
+  static LoopWorld* world_;
+};
+
+LoopWorld* LoopCloserTest::world_ = nullptr;
+
+// The finished submap, handed over as mapd does.
+std::shared_ptr<const mapping::Submap> Take(SyntheticSubmap s) {
+  return std::shared_ptr<const mapping::Submap>(std::move(s.submap));
+}
+
+TEST_F(LoopCloserTest, ARevisitIsMatchedNearTheTruthOnceItsOriginIsKnown) {
+  LoopCloser closer({}, 0);
+  for (uint32_t frame : {1u, 2u, 3u}) closer.AddSubmap(Take(Render(frame)));
+  closer.Flush();
+  // No origin known yet: nothing can be paired.
+  EXPECT_TRUE(closer.TakeMatches().empty());
+  EXPECT_EQ(closer.Stats().submaps, 3u);
+
+  closer.UpdateOrigins(DriftedOrigins());
+  closer.Flush();
+  const std::vector<LoopMatch> matches = closer.TakeMatches();
+  ASSERT_EQ(matches.size(), 1u) << "only the revisit overlaps a non-successive submap";
+  const LoopMatch& m = matches.front();
+  EXPECT_EQ(std::min(m.a.index, m.b.index), 1);
+  EXPECT_EQ(std::max(m.a.index, m.b.index), 3);
+  ASSERT_TRUE(m.accepted) << m.rejection;
+  const Eigen::Isometry3d truth =
+      Truth(static_cast<uint32_t>(m.a.index)).inverse() * Truth(static_cast<uint32_t>(m.b.index));
+  const mapping::testing::PoseError e = mapping::testing::ErrorOf(m.T_a_b, truth);
+  // A valid loop closure (the matcher's own accuracy is tested with it).
+  EXPECT_LT(e.translation_m, 0.2);
+  EXPECT_LT(e.rotation_rad, 1.0 * kDeg);
+  // The prior carried the drift; the match removes it.
+  const mapping::testing::PoseError prior = mapping::testing::ErrorOf(m.prior.T_a_b, truth);
+  EXPECT_GT(prior.translation_m, 0.2);
+  EXPECT_TRUE(m.covariance.allFinite());
+  EXPECT_GT(m.covariance.determinant(), 0.0);
+  EXPECT_GT(m.match_ms, 0.0);
+
+  const LoopCloserStats stats = closer.Stats();
+  EXPECT_EQ(stats.pairs_matched, 1u);
+  EXPECT_EQ(stats.matches_accepted, 1u);
+  EXPECT_EQ(stats.data_ms.size(), 3u);
+  EXPECT_EQ(stats.match_ms.size(), 1u);
+
+  // A pair is matched once: new origins do not bring it back.
+  closer.UpdateOrigins(DriftedOrigins());
+  closer.Flush();
+  EXPECT_TRUE(closer.TakeMatches().empty());
+}
+
+TEST_F(LoopCloserTest, ASubmapWithoutStructureIsCountedAndNeverPaired) {
+  LoopWorld flat;  // sloped ground, no rock
+  SyntheticSubmap first = Drive(flat, {0.0, 0.0}, 0.0, 21, 1);
+  SyntheticSubmap revisit = Drive(flat, {1.0, 0.5}, 0.2, 23, 3);
+  std::map<int64_t, OptimisedOrigin> origins;
+  origins[1] = Estimate(first.T_world_submap, {0, 0, 0}, 0.0, 0.01, 0.1 * kDeg);
+  origins[3] = Estimate(revisit.T_world_submap, {0.3, 0, 0}, 0.0, 0.5, 3.0 * kDeg);
+  LoopCloser closer({}, 0);
+  closer.AddSubmap(Take(std::move(first)));
+  closer.AddSubmap(Take(std::move(revisit)));
+  closer.UpdateOrigins(origins);
+  closer.Flush();
+  EXPECT_TRUE(closer.TakeMatches().empty());
+  const LoopCloserStats stats = closer.Stats();
+  EXPECT_EQ(stats.submaps, 2u);
+  EXPECT_EQ(stats.submaps_suitable, 0u);
+  EXPECT_EQ(stats.pairs_matched, 0u);
+}
+
+TEST_F(LoopCloserTest, AnEmptySubmapOrANullHandOverIsHarmless) {
+  LoopCloser closer({}, 0);
+  closer.AddSubmap(nullptr);
+  auto empty = std::make_shared<mapping::Submap>(5, 5, mapping::SubmapOptions{});
+  empty->Finish();
+  closer.AddSubmap(empty);
+  closer.Flush();
+  const LoopCloserStats stats = closer.Stats();
+  EXPECT_EQ(stats.submaps, 1u);
+  EXPECT_EQ(stats.submaps_suitable, 0u);
+}
+
+TEST_F(LoopCloserTest, StoppingWithWorkQueuedReturns) {
+  auto closer = std::make_unique<LoopCloser>(LoopCloserOptions{}, 0);
+  closer->AddSubmap(Take(Render(1)));
+  closer->AddSubmap(Take(Render(3)));
+  closer->UpdateOrigins(DriftedOrigins());
+  closer->Stop();
+  closer->Stop();  // idempotent
+  closer.reset();  // and the destructor after it
+  SUCCEED();
+}
+
+TEST(LoopCloserOptionsTest, InvalidOptionsNameTheKey) {
+  LoopCloserOptions o;
+  o.max_queued_pairs = 0;
+  try {
+    o.Validate();
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("LoopCloserOptions.max_queued_pairs"), std::string::npos)
+        << e.what();
+  }
+  o = {};
+  o.matcher.min_sigma_m = -1.0;
+  EXPECT_THROW(LoopCloser(o, 0), std::invalid_argument);
+  const ConfigNode node = ConfigNode::LoadString(
+      "max_queued_pairs: 4\nnice_increment: 5\nmatcher: {mode: six_dof}\n", "test");
+  const LoopCloserOptions loaded = LoopCloserOptions::Load(node);
+  EXPECT_EQ(loaded.max_queued_pairs, 4);
+  EXPECT_EQ(loaded.nice_increment, 5);
+  EXPECT_EQ(loaded.matcher.mode, mapping::MatchMode::kSixDof);
+}
+
+}  // namespace
+}  // namespace rover::mapd
