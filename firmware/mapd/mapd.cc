@@ -42,6 +42,16 @@ std::unique_ptr<ipc::Subscriber<T>> Subscribe(ipc::Transport* transport, std::st
   return s;
 }
 
+void FillPose(const Eigen::Isometry3d& T, std::array<double, 3>* p, std::array<double, 4>* q_wxyz) {
+  const Eigen::Quaterniond q(T.linear());
+  *p = {T.translation().x(), T.translation().y(), T.translation().z()};
+  *q_wxyz = {q.w(), q.x(), q.y(), q.z()};
+}
+
+void FillCovariance(const mapping::Matrix6d& c, std::array<double, 36>* out) {
+  for (int i = 0; i < 36; ++i) (*out)[static_cast<std::size_t>(i)] = c(i / 6, i % 6);
+}
+
 template <typename T>
 std::unique_ptr<ipc::Publisher<T>> Advertise(ipc::Transport* transport, std::string_view name,
                                              uint64_t history) {
@@ -161,6 +171,11 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
                                                mapping::MapComposerOptions{});
   }
   if (options_.slam) {
+    // History: a late subscriber gets the latest pose, and the latest
+    // origins whole up to 16 pages.
+    global_pose_ = Advertise<topics::GlobalPoseMsg>(transport, topics::kGlobalPoseTopic, 1);
+    origins_ = Advertise<topics::SubmapOriginsMsg>(transport, topics::kSubmapOriginsTopic,
+                                                   topics::kSwitchHistory);
     slam_ = std::make_unique<SlamWorker>(options_.graph, options_.robot_id);
     LoadResumeCandidate();
     if (options_.mapping && options_.loop_closures) {
@@ -552,6 +567,45 @@ void Mapd::LogAndSubmit(const log::rover_msgs::GraphFactor& msg) {
   }
 }
 
+void Mapd::PublishGraphState(const SlamSnapshot& snap) {
+  const uint32_t total = static_cast<uint32_t>(snap.origins.size());
+  const uint32_t per_page = topics::SubmapOriginsMsg::kMaxOrigins;
+  const uint32_t pages = std::max(1u, (total + per_page - 1) / per_page);
+  auto origin = snap.origins.begin();
+  bool sent = true;
+  for (uint32_t page = 0; page < pages; ++page) {
+    sent = origins_->PublishInPlace([&](topics::SubmapOriginsMsg& m) {
+      m.version = topics::kTopicsVersion;
+      m.update = snap.update;
+      m.stamp_ns = snap.stamp_ns;
+      m.first = page * per_page;
+      m.count = std::min(per_page, total - m.first);
+      m.total = total;
+      m.page = page;
+      m.pages = pages;
+      for (uint32_t k = 0; k < m.count; ++k, ++origin) {
+        topics::SubmapOriginEntry& e = m.origins[k];
+        e.robot = options_.robot_id;
+        e.frame_id = static_cast<uint32_t>(origin->first);
+        FillPose(origin->second.T_world_origin, &e.p_world_origin_m, &e.q_world_origin_wxyz);
+        FillCovariance(origin->second.covariance, &e.covariance);
+      }
+    }) && sent;
+  }
+  if (snap.T_world_body) {
+    sent = global_pose_->PublishInPlace([&](topics::GlobalPoseMsg& m) {
+      m.version = topics::kTopicsVersion;
+      m.robot = options_.robot_id;
+      m.stamp_ns = snap.global_pose_stamp_ns;
+      m.update = snap.update;
+      m.frame_id = snap.global_pose_frame_id;
+      FillPose(*snap.T_world_body, &m.p_world_body_m, &m.q_world_body_wxyz);
+      FillCovariance(snap.global_pose_covariance, &m.covariance);
+    }) && sent;
+  }
+  if (sent) ++stats_.graph_states_published;
+}
+
 void Mapd::TakeLoopMatches() {
   for (const std::string& problem : loop_->TakeProblems()) {
     std::fprintf(stderr, "mapd: %s\n", problem.c_str());
@@ -579,6 +633,8 @@ void Mapd::TakeSlamSnapshot() {
   const SlamSnapshot snap = slam_->Latest();
   if (snap.update == last_snapshot_update_) return;
   last_snapshot_update_ = snap.update;
+  PublishGraphState(snap);
+  if (loop_) loop_->UpdateOrigins(snap.origins);
   if (!archive_) return;
   std::map<int64_t, Eigen::Isometry3d> T_world_frame;
   log::rover_msgs::SubmapOrigins origins;
@@ -596,7 +652,6 @@ void Mapd::TakeSlamSnapshot() {
     origins.origins.push_back(m);
   }
   archive_->SetOrigins(T_world_frame);
-  if (loop_) loop_->UpdateOrigins(snap.origins);
   std::optional<log::geometry_msgs::PoseWithCovarianceStamped> pose;
   if (snap.T_world_body) {
     pose.emplace();

@@ -119,9 +119,10 @@ struct MapdStats {
   uint64_t cloud_bytes = 0;       ///< serialised sensor_msgs/PointCloud2 of finished submaps
   uint64_t obstacle_points = 0;
   uint64_t grids_published = 0;
-  uint64_t graph_factors_refused = 0;  ///< malformed before reaching the graph (NaN, ...)
-  uint64_t graph_factors_resumed = 0;  ///< taken over from the previous mapd's log
-  uint64_t loop_closures = 0;          ///< accepted matches added to the graph
+  uint64_t graph_states_published = 0;  ///< updates whose origins and pose went out
+  uint64_t graph_factors_refused = 0;   ///< malformed before reaching the graph (NaN, ...)
+  uint64_t graph_factors_resumed = 0;   ///< taken over from the previous mapd's log
+  uint64_t loop_closures = 0;           ///< accepted matches added to the graph
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
@@ -205,6 +206,8 @@ class Mapd {
   void TakeSlamSnapshot();
   /// Hands the newest estimate to the graph thread for the global pose.
   void HandLatestPose();
+  /// Publishes the snapshot's origins (in pages) and global pose.
+  void PublishGraphState(const SlamSnapshot& snap);
   /// Adds the loop closer's accepted matches to the graph.
   void TakeLoopMatches();
 
@@ -217,6 +220,8 @@ class Mapd {
   std::unique_ptr<ipc::Publisher<runtime::topics::MapdStatusMsg>> status_;
   std::unique_ptr<ipc::Subscriber<runtime::topics::StereoCalibrationMsg>> calibration_;
   std::unique_ptr<ipc::Publisher<runtime::topics::TraversabilityMsg>> traversability_;
+  std::unique_ptr<ipc::Publisher<runtime::topics::GlobalPoseMsg>> global_pose_;
+  std::unique_ptr<ipc::Publisher<runtime::topics::SubmapOriginsMsg>> origins_;
   /// 2 MB: one frame buffer, allocated once.
   std::unique_ptr<runtime::topics::StereoFrameMsg> frame_buffer_;
   /// The newest pair waiting for its estimates (mapping only).

@@ -9,6 +9,8 @@
 //   /mapd/frame_switch_request    mapd -> roverd   "start a new submap now"
 //   /mapd/status                  mapd -> anyone   submaps, inputs, restarts
 //   /roverd/diagnostics           roverd -> anyone health, once per health period
+//   /mapd/global_pose             mapd -> anyone   the pose graph's global pose s_j (+) v_t
+//   /mapd/submap_origins          mapd -> anyone   the optimised submap origins, in pages
 //
 // Messages are plain fixed-size structs (ipc::Message: copied byte-wise into
 // shared memory), so both processes must be built from the same sources;
@@ -24,7 +26,7 @@
 namespace rover::runtime::topics {
 
 /// Bumped whenever a message below changes layout or meaning.
-inline constexpr uint32_t kTopicsVersion = 2;
+inline constexpr uint32_t kTopicsVersion = 3;
 
 inline constexpr std::string_view kPoseTopic = "/roverd/pose";
 inline constexpr std::string_view kStereoFrameTopic = "/roverd/stereo_frame";
@@ -34,6 +36,8 @@ inline constexpr std::string_view kMapdStatusTopic = "/mapd/status";
 inline constexpr std::string_view kDiagnosticsTopic = "/roverd/diagnostics";
 inline constexpr std::string_view kStereoCalibrationTopic = "/roverd/stereo_calibration";
 inline constexpr std::string_view kTraversabilityTopic = "/mapd/traversability";
+inline constexpr std::string_view kGlobalPoseTopic = "/mapd/global_pose";
+inline constexpr std::string_view kSubmapOriginsTopic = "/mapd/submap_origins";
 
 /// PoseMsg::status bit: the filter is not initialised yet (the same bit as
 /// estimator::kStatusNotInitialised, checked where roverd fills the message),
@@ -150,6 +154,53 @@ struct TraversabilityMsg {
   uint32_t version = kTopicsVersion;
   uint32_t cdr_size = 0;
   std::array<std::byte, kMaxCdrBytes> cdr;
+};
+
+/// The pose graph's current global pose of this rover after a graph update:
+/// the optimised origin of the filter's current local frame composed with
+/// the filter's latest estimate in it (s_j (+) v_t). Published with history
+/// 1. It is never fed back into the filter.
+struct GlobalPoseMsg {
+  uint32_t version = kTopicsVersion;
+  int32_t robot = 0;
+  int64_t stamp_ns = 0;   ///< of the filter estimate it is composed from
+  uint64_t update = 0;    ///< graph update it comes from (1, 2, ...)
+  uint32_t frame_id = 0;  ///< the local frame of that estimate
+  uint32_t reserved = 0;
+  std::array<double, 3> p_world_body_m{};
+  std::array<double, 4> q_world_body_wxyz{1.0, 0.0, 0.0, 0.0};
+  /// Row-major 6x6 over [dp (world, m); dtheta (body, rad)].
+  std::array<double, 36> covariance{};
+};
+
+/// One optimised submap origin (a local frame of the filter).
+struct SubmapOriginEntry {
+  int32_t robot = 0;
+  uint32_t frame_id = 0;
+  std::array<double, 3> p_world_origin_m{};
+  std::array<double, 4> q_world_origin_wxyz{1.0, 0.0, 0.0, 0.0};
+  /// Row-major 6x6 marginal over [dp (world, m); dtheta (origin, rad)];
+  /// all zero when the graph did not compute it.
+  std::array<double, 36> covariance{};
+};
+
+/// The origins after one graph update, in pages of at most kMaxOrigins
+/// (one 64 KiB chunk each): page `page` of `pages` holds the origins
+/// [first, first + count) of `total`, ordered by robot and frame. A reader
+/// has the whole update once it holds every page with the same `update`.
+/// Published with history 16 (iceoryx's cap), so a late subscriber gets the
+/// latest update whole up to 16 pages (2048 origins).
+struct SubmapOriginsMsg {
+  static constexpr uint32_t kMaxOrigins = 128;
+  uint32_t version = kTopicsVersion;
+  uint32_t count = 0;
+  uint64_t update = 0;
+  int64_t stamp_ns = 0;  ///< of the newest factor in the update
+  uint32_t first = 0;
+  uint32_t total = 0;
+  uint32_t page = 0;
+  uint32_t pages = 0;
+  std::array<SubmapOriginEntry, kMaxOrigins> origins{};
 };
 
 /// CameraCalibrationMsg::distortion_model values (calib::DistortionModel).

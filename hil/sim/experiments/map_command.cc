@@ -102,19 +102,48 @@ std::string Num(double v, int digits) {
   return text;
 }
 
+// Counts the graph's submap matches and those that hold against the truth.
+// A local frame starts at the body's position and yaw at its switch, so its
+// true origin is the true body pose then (x, y, z, yaw); frame 0's is
+// T_world_local0. A match naming a frame of unknown truth counts as invalid.
+void ScoreLoopClosures(const mapping::GraphLogContents& g, const sim::RoverTrajectory& trajectory,
+                       const MissionFacts& mission, const Eigen::Isometry3d& T_world_local0,
+                       MapResult* r) {
+  std::map<int64_t, Eigen::Isometry3d> truth;
+  for (const mapping::GraphFactorRecord& f : g.factors) {
+    if (f.kind == mapping::FactorKind::kPrior && f.a.index == 0) truth[0] = T_world_local0;
+    if (f.kind != mapping::FactorKind::kFrameSwitch) continue;
+    const double t_s = (Time::FromNanoseconds(f.stamp_ns) - mission.start).ToSeconds();
+    const sim::TrajectorySample s = trajectory.Evaluate(t_s);
+    truth[f.a.index + 1] = FourDof(s.p_world_body, s.q_world_body.toRotationMatrix());
+  }
+  for (const mapping::GraphFactorRecord& f : g.factors) {
+    if (f.kind != mapping::FactorKind::kSubmapMatch || !f.b) continue;
+    ++r->loop_closures;
+    const auto a = truth.find(f.a.index);
+    const auto b = truth.find(f.b->index);
+    if (a == truth.end() || b == truth.end()) continue;
+    const Eigen::Isometry3d error = (a->second.inverse() * b->second).inverse() * f.T_a_b;
+    const double angle_rad = Eigen::AngleAxisd(error.linear()).angle();
+    if (error.translation().norm() <= 0.2 && angle_rad <= M_PI / 180.0) ++r->loop_closures_valid;
+  }
+  r->loop_closure_precision = r->loop_closures > 0 ? static_cast<double>(r->loop_closures_valid) /
+                                                         static_cast<double>(r->loop_closures)
+                                                   : std::numeric_limits<double>::quiet_NaN();
+}
+
 // The submaps at the pose graph's optimised origins (mapping::
 // PlaceAtGraphOrigins), and the graph's final global pose against the truth.
 // A restarted mapd's log holds the whole graph again; later logs win.
 void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
                          const sim::RoverTrajectory& trajectory, const MissionFacts& mission,
+                         const Eigen::Isometry3d& T_world_local0,
                          std::map<uint32_t, Eigen::Isometry3d>* origins, MapResult* r,
                          std::ostream& report) {
   for (const std::string& path : mapd_logs) {
     const mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
     for (const std::string& p : g.problems) report << "    graph: " << p << "\n";
-    for (const mapping::GraphFactorRecord& f : g.factors) {
-      if (f.kind == mapping::FactorKind::kSubmapMatch) ++r->loop_closures;
-    }
+    ScoreLoopClosures(g, trajectory, mission, T_world_local0, r);
     if (!g.last_origins) continue;
     const std::optional<Eigen::Isometry3d> T_world_graph =
         mapping::GraphInMap(*g.last_origins, *origins);
@@ -171,7 +200,7 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   for (auto& [frame, T] : origins) T = T_world_local0 * T;
 
   MapResult r;
-  PlaceAtGraphOrigins(o.mapd_logs, trajectory, mission, &origins, &r, report);
+  PlaceAtGraphOrigins(o.mapd_logs, trajectory, mission, T_world_local0, &origins, &r, report);
   std::vector<mapping::SubmapLog> logs;
   uint64_t submap_bytes = 0;
   for (const std::string& path : o.mapd_logs) {
@@ -187,6 +216,12 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
           std::max(r.raw_stereo_bytes_per_s, std::stod(l.statistics.at("raw_stereo_bytes_per_s")));
     }
     r.submaps += l.submaps.size();
+    if (l.statistics.count("matcher_ms_p50")) {
+      r.matcher_ms_p50 = std::stod(l.statistics.at("matcher_ms_p50"));
+    }
+    if (l.statistics.count("graph_update_ms_p99")) {
+      r.graph_update_ms_p99 = std::stod(l.statistics.at("graph_update_ms_p99"));
+    }
   }
   mapping::MapComposer composer;
   const std::size_t unplaced = mapping::AddLoggedSubmaps(logs, origins, &composer);
@@ -241,7 +276,9 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
          << " %)\n"
          << "  slam       final error " << Num(r.slam_final_error_m, 3) << " m ("
          << Num(r.slam_final_error_pct, 4) << " % of distance), " << r.loop_closures
-         << " loop closures, " << r.graph_origins << " submaps at the graph's origins\n";
+         << " loop closures (" << r.loop_closures_valid << " within 0.2 m and 1 deg of the truth), "
+         << r.graph_origins << " submaps at the graph's origins; match " << Num(r.matcher_ms_p50, 1)
+         << " ms p50, graph update " << Num(r.graph_update_ms_p99, 1) << " ms p99\n";
   return r;
 }
 
@@ -252,7 +289,10 @@ std::string MapResultFields(const MapResult& r) {
          " obstacle_recall=" + Num(q.obstacle_recall, 4) + " submaps=" + std::to_string(r.submaps) +
          " submap_bytes_per_s=" + Num(r.submap_bytes_per_s, 0) +
          " raw_stereo_bytes_per_s=" + Num(r.raw_stereo_bytes_per_s, 0) +
-         " loop_closures=" + std::to_string(r.loop_closures);
+         " loop_closures=" + std::to_string(r.loop_closures) +
+         " loop_closure_precision=" + Num(r.loop_closure_precision, 3) +
+         " matcher_ms_p50=" + Num(r.matcher_ms_p50, 1) +
+         " graph_update_ms_p99=" + Num(r.graph_update_ms_p99, 1);
 }
 
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err) {

@@ -44,6 +44,13 @@ struct MapResult {
   double slam_final_error_m = std::numeric_limits<double>::quiet_NaN();
   double slam_final_error_pct = std::numeric_limits<double>::quiet_NaN();
   uint64_t loop_closures = 0;  ///< submap matches in the graph (c factors)
+  /// Those within 0.2 m and 1 deg of the truth (the origins' true poses: the
+  /// true body pose, x y z yaw, at each frame switch), and their share.
+  uint64_t loop_closures_valid = 0;
+  double loop_closure_precision = std::numeric_limits<double>::quiet_NaN();
+  /// From mapd's log statistics (the last log that has them; nan if none).
+  double matcher_ms_p50 = std::numeric_limits<double>::quiet_NaN();
+  double graph_update_ms_p99 = std::numeric_limits<double>::quiet_NaN();
   uint64_t graph_origins = 0;  ///< submaps placed at the graph's origins
 };
 
@@ -56,7 +63,8 @@ std::string MapResultFields(const MapResult& r);
 /// Runs the evaluation, prints the report and, as the last line,
 ///   RESULT map_precision=... map_recall=... obstacle_precision=...
 ///          obstacle_recall=... submaps=... submap_bytes_per_s=...
-///          raw_stereo_bytes_per_s=...
+///          raw_stereo_bytes_per_s=... loop_closures=...
+///          loop_closure_precision=... matcher_ms_p50=... graph_update_ms_p99=...
 /// Errors go to `err`; returns kExitBadInput for unusable input.
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err);
 

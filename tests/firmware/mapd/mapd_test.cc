@@ -199,6 +199,37 @@ TEST_F(MapdTest, TheGraphChainsTheSwitchesAndComposesTheGlobalPose) {
   const SlamStats stats = mapd_.slam_stats();
   EXPECT_EQ(stats.factors_added, 3u);  // the prior and two switches
   EXPECT_EQ(stats.factors_refused, 0u);
+
+  // A late subscriber gets the latest global pose and origins from history.
+  auto pose_sub = transport_.MakeSubscriber<topics::GlobalPoseMsg>(
+      T(topics::kGlobalPoseTopic), {.queue_capacity = 1, .history_request = 1});
+  auto origins_sub = transport_.MakeSubscriber<topics::SubmapOriginsMsg>(
+      T(topics::kSubmapOriginsTopic), {.queue_capacity = 8, .history_request = 8});
+  topics::GlobalPoseMsg pose;
+  ASSERT_TRUE(pose_sub->TryTake(&pose));
+  EXPECT_EQ(pose.version, topics::kTopicsVersion);
+  EXPECT_EQ(pose.frame_id, 2u);
+  EXPECT_EQ(pose.stamp_ns, Time::FromSeconds(3.0).nanoseconds());
+  const Eigen::Vector3d p_expected = *snap.T_world_body * Eigen::Vector3d::Zero();
+  EXPECT_NEAR(pose.p_world_body_m[0], p_expected.x(), 1e-6);
+  EXPECT_NEAR(pose.p_world_body_m[1], p_expected.y(), 1e-6);
+  EXPECT_GT(pose.covariance[0], 0.0);
+  topics::SubmapOriginsMsg origins;
+  topics::SubmapOriginsMsg latest;
+  bool any = false;
+  while (origins_sub->TryTake(&origins)) {
+    latest = origins;
+    any = true;
+  }
+  ASSERT_TRUE(any);
+  EXPECT_EQ(latest.update, pose.update);
+  ASSERT_EQ(latest.total, 3u);
+  EXPECT_EQ(latest.count, 3u);
+  EXPECT_EQ(latest.pages, 1u);
+  EXPECT_EQ(latest.origins[1].frame_id, 1u);
+  EXPECT_NEAR(latest.origins[1].p_world_origin_m[0], 7.0, 1e-6);
+  EXPECT_NEAR(latest.origins[2].p_world_origin_m[0], s2.translation().x(), 1e-6);
+  EXPECT_GT(latest.origins[2].covariance[0], latest.origins[1].covariance[0]);
 }
 
 // A switch record with a NaN covariance is left out with a message; the
