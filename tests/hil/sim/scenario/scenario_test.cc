@@ -23,14 +23,15 @@ Scenario Load(const std::string& name) {
   return LoadScenario(FindScenario(DefaultScenarioDir(), name), DefaultSimConfigDir());
 }
 
-TEST(ScenarioTest, TheFourShippedScenariosLoad) {
+TEST(ScenarioTest, TheShippedScenariosLoad) {
   std::vector<std::string> names;
   for (const std::string& f : ListScenarioFiles(DefaultScenarioDir())) {
     const Scenario s = LoadScenario(f, DefaultSimConfigDir());
     EXPECT_EQ(s.name, fs::path(f).stem().string()) << "name must match the file name";
     names.push_back(s.name);
   }
-  EXPECT_THAT(names, ::testing::IsSupersetOf({"short", "loop-100m", "mixed-300m", "two-rovers"}));
+  EXPECT_THAT(names, ::testing::IsSupersetOf({"short", "loop-100m", "mixed-300m", "two-rovers",
+                                              "figure-eight-1km", "monotonous-200m"}));
 }
 
 TEST(ScenarioTest, RouteLengthsAndDurationsMatchTheirNames) {
@@ -41,6 +42,31 @@ TEST(ScenarioTest, RouteLengthsAndDurationsMatchTheirNames) {
   EXPECT_NEAR(loop.distance_m(), 100.0, 5.0);
   const RoverTrajectory mixed(Load("mixed-300m").route, flat);
   EXPECT_NEAR(mixed.distance_m(), 300.0, 15.0);
+  const RoverTrajectory eight(Load("figure-eight-1km").route, flat);
+  EXPECT_NEAR(eight.distance_m(), 1000.0, 30.0);
+  const RoverTrajectory lanes(Load("monotonous-200m").route, flat);
+  EXPECT_NEAR(lanes.distance_m(), 200.0, 10.0);
+}
+
+TEST(ScenarioTest, TheFigureEightRevisitsItsGroundFromTheOppositeDirection) {
+  const Heightfield flat = Flat();
+  const RoverTrajectory eight(Load("figure-eight-1km").route, flat);
+  // Halfway, the rover passes the crossing again and retraces the first
+  // half backwards: at mirrored times it is at the same place, heading the
+  // other way.
+  const double half_s = 0.5 * eight.duration_s();
+  int checked = 0;
+  for (double f = 0.05; f < 0.45; f += 0.05) {
+    const double t_s = f * eight.duration_s();
+    const TrajectorySample a = eight.Evaluate(t_s);
+    const TrajectorySample b = eight.Evaluate(2.0 * half_s - t_s);
+    if ((a.p_world_body - b.p_world_body).head<2>().norm() > 3.0) continue;
+    const Eigen::Vector3d forward_a = a.q_world_body * Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d forward_b = b.q_world_body * Eigen::Vector3d::UnitX();
+    EXPECT_LT(forward_a.dot(forward_b), -0.9) << "at t = " << t_s << " s";
+    ++checked;
+  }
+  EXPECT_GE(checked, 3) << "the reverse pass must retrace the forward one";
 }
 
 TEST(ScenarioTest, MixedRunsAlongTheCraterWithoutEnteringIt) {
