@@ -20,6 +20,8 @@
 #include "mapping/compose/map_composer.h"
 #include "mapping/compose/map_export.h"
 #include "mapping/compose/submap_log.h"
+#include "mapping/graph/rover_graph.h"
+#include "mapping/slam/false_match_injection.h"
 #include "mapping/slam/graph_log.h"
 
 namespace rover::sim::experiments {
@@ -132,12 +134,53 @@ void ScoreLoopClosures(const mapping::GraphLogContents& g, const sim::RoverTraje
                                                    : std::numeric_limits<double>::quiet_NaN();
 }
 
+// The final global pose after re-solving the logged graph, with `extra`
+// factors: the logged pose's offset from its frame's logged origin (its
+// frame: the newest origin) moved with that origin.
+Eigen::Vector3d ResolvedFinalPosition(const mapping::GraphLogContents& g,
+                                      const std::vector<mapping::GraphFactorRecord>& extra) {
+  mapping::RoverGraph graph;
+  for (const mapping::GraphFactorRecord& f : g.factors) mapping::AddToGraph(f, &graph);
+  for (const mapping::GraphFactorRecord& f : extra) mapping::AddToGraph(f, &graph);
+  graph.Optimize();
+  const log::rover_msgs::SubmapOrigin& newest = g.last_origins->origins.back();
+  const Eigen::Isometry3d T_world_body = mapping::FromPoseMsg(g.last_global_pose->pose.pose);
+  const Eigen::Isometry3d T_local_body = mapping::FromPoseMsg(newest.pose).inverse() * T_world_body;
+  return (graph.Origin(newest.robot, newest.submap) * T_local_body).translation();
+}
+
+// Re-solves the logged graph as it is and with false matches added, and
+// scores both final positions as the logged one.
+void ScoreFalseMatches(const mapping::GraphLogContents& g, const Eigen::Isometry3d& T_world_graph,
+                       const Eigen::Vector3d& p_true, double distance_m, const MapCommandOptions& o,
+                       MapResult* r, std::ostream& report) {
+  if (g.last_origins->origins.empty()) return;
+  std::map<int64_t, Eigen::Isometry3d> estimates;
+  for (const log::rover_msgs::SubmapOrigin& origin : g.last_origins->origins) {
+    estimates[origin.submap] = mapping::FromPoseMsg(origin.pose);
+  }
+  mapping::FalseMatchOptions options;
+  options.fraction = o.false_match_fraction;
+  options.seed = o.false_match_seed;
+  const std::vector<mapping::GraphFactorRecord> false_matches = mapping::MakeFalseSubmapMatches(
+      g.factors, g.last_origins->origins.front().robot, estimates, options);
+  r->false_matches = false_matches.size();
+  const Eigen::Vector3d as_logged = T_world_graph * ResolvedFinalPosition(g, {});
+  const Eigen::Vector3d with_false = T_world_graph * ResolvedFinalPosition(g, false_matches);
+  r->resolved_error_pct = 100.0 * (as_logged - p_true).norm() / distance_m;
+  r->false_match_error_pct = 100.0 * (with_false - p_true).norm() / distance_m;
+  report << "  false matches: the logged graph re-solved: final error "
+         << Num(r->resolved_error_pct, 4) << " %; with " << false_matches.size()
+         << " false matches added (" << Num(100.0 * o.false_match_fraction, 0)
+         << " % of all matches): " << Num(r->false_match_error_pct, 4) << " %\n";
+}
+
 // The submaps at the pose graph's optimised origins (mapping::
 // PlaceAtGraphOrigins), and the graph's final global pose against the truth.
 // A restarted mapd's log holds the whole graph again; later logs win.
 void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
                          const sim::RoverTrajectory& trajectory, const MissionFacts& mission,
-                         const Eigen::Isometry3d& T_world_local0,
+                         const Eigen::Isometry3d& T_world_local0, const MapCommandOptions& options,
                          std::map<uint32_t, Eigen::Isometry3d>* origins, MapResult* r,
                          std::ostream& report) {
   for (const std::string& path : mapd_logs) {
@@ -166,6 +209,9 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     r->slam_final_error_m = (p_est - p_true).norm();
     r->slam_final_error_pct = distance_m > 0.0 ? 100.0 * r->slam_final_error_m / distance_m
                                                : std::numeric_limits<double>::quiet_NaN();
+    if (options.false_match_fraction > 0.0 && distance_m > 0.0) {
+      ScoreFalseMatches(g, *T_world_graph, p_true, distance_m, options, r, report);
+    }
   }
 }
 
@@ -200,7 +246,7 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   for (auto& [frame, T] : origins) T = T_world_local0 * T;
 
   MapResult r;
-  PlaceAtGraphOrigins(o.mapd_logs, trajectory, mission, T_world_local0, &origins, &r, report);
+  PlaceAtGraphOrigins(o.mapd_logs, trajectory, mission, T_world_local0, o, &origins, &r, report);
   std::vector<mapping::SubmapLog> logs;
   uint64_t submap_bytes = 0;
   for (const std::string& path : o.mapd_logs) {
@@ -335,6 +381,13 @@ Subcommand AddMapCommand(CLI::App& app) {
                   "recall counts the true obstacles the camera saw from within this distance, "
                   "from where stereo resolves their height above a wheel's step")
       ->capture_default_str();
+  cmd->add_option("--false-matches", options->false_match_fraction,
+                  "also re-solve mapd's graph with this share of its submap matches false "
+                  "(tempting ones: near pairs, 1-4 m and up to 29 deg off), and report the final "
+                  "error with and without them")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
+  cmd->add_option("--false-match-seed", options->false_match_seed)->capture_default_str();
   return {cmd, [options] { return RunMap(*options, std::cout, std::cerr); }};
 }
 

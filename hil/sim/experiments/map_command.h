@@ -29,6 +29,10 @@ struct MapCommandOptions {
   /// Also write the world-frame map to STEM.bt and STEM.ply.
   std::string export_stem;
   MapQualityOptions quality;
+  /// Re-solve the logged graph with this share of its matches false
+  /// (mapping::MakeFalseSubmapMatches); 0: not done.
+  double false_match_fraction = 0.0;
+  uint64_t false_match_seed = 1;
 };
 
 /// What RunMap measured (for rover-launch's RESULT line).
@@ -52,6 +56,11 @@ struct MapResult {
   double matcher_ms_p50 = std::numeric_limits<double>::quiet_NaN();
   double graph_update_ms_p99 = std::numeric_limits<double>::quiet_NaN();
   uint64_t graph_origins = 0;  ///< submaps placed at the graph's origins
+  /// With false_match_fraction: the logged graph re-solved as it is, and
+  /// with the false matches added (final error, % of distance).
+  uint64_t false_matches = 0;
+  double resolved_error_pct = std::numeric_limits<double>::quiet_NaN();
+  double false_match_error_pct = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Evaluates; throws std::runtime_error naming the file or the problem.
