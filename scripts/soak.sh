@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# Soak test: one long lockstep mission with the full roverd + mapd stack (the
+# figure-eight-1km route driven LAPS times in one go), sampling both
+# processes' resident memory. Passes if, after the first WARMUP_S seconds of
+# wall time, neither process's RSS grew by more than MAX_GROWTH_PCT and the
+# mission reports no IMU or frame drops. Not a CI test: one lap takes about
+# half an hour on a machine like the CI's.
+#
+# Usage: scripts/soak.sh [--laps N] [--seed S] [--out DIR] [--period-s P]
+#   --laps N        laps of the figure-eight (default 2: about 2 km, an hour)
+#   --seed S        world seed (default 1)
+#   --out DIR       where the logs, the memory samples (rss.csv) and the
+#                   summary go (default build/soak)
+#   --period-s P    seconds between memory samples (default 30)
+# Needs the dev build (./rover build dev).
+set -euo pipefail
+
+cd "$(dirname "$0")/.."
+LAPS=2
+SEED=1
+OUT=build/soak
+PERIOD_S=30
+WARMUP_S=${WARMUP_S:-600}
+MAX_GROWTH_PCT=${MAX_GROWTH_PCT:-5}
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --laps) LAPS=$2; shift 2 ;;
+    --seed) SEED=$2; shift 2 ;;
+    --out) OUT=$2; shift 2 ;;
+    --period-s) PERIOD_S=$2; shift 2 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    *) echo "soak: unknown option '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[[ "$LAPS" =~ ^[1-9][0-9]*$ ]] || { echo "soak: --laps expects a positive integer, got '$LAPS'" >&2; exit 2; }
+BIN=build/dev
+for b in hil/sim/mission/rover-launch hil/sim/mission/roverd-sim firmware/mapd/mapd; do
+  [[ -x "$BIN/$b" ]] || { echo "soak: $BIN/$b missing: run ./rover build dev first" >&2; exit 2; }
+done
+
+mkdir -p "$OUT/scenarios"
+OUT=$(cd "$OUT" && pwd)
+# The soak scenario: figure-eight-1km with its waypoints repeated LAPS times.
+SRC=hil/scenarios/figure-eight-1km.yaml
+awk -v laps="$LAPS" '
+  /^name:/ { print "name: figure-eight-soak"; next }
+  /^description:/ { print "description: \"figure-eight-1km driven " laps " times\""; next }
+  /^  waypoints:/ { print; inwp = 1; next }
+  inwp && /^    - / { wp[n++] = $0; next }
+  inwp { for (l = 0; l < laps; ++l) for (i = 0; i < n; ++i) print wp[i]; inwp = 0 }
+  { print }
+' "$SRC" > "$OUT/scenarios/figure-eight-soak.yaml"
+cp hil/scenarios/*.yaml "$OUT/scenarios/" 2>/dev/null || true
+
+echo "soak: $LAPS lap(s) of the figure-eight, seed $SEED, logs in $OUT"
+RUN_LOG="$OUT/mission.txt"
+ROVER_SCENARIO_DIR="$OUT/scenarios" "$BIN/hil/sim/mission/rover-launch" \
+  --roverd-sim "$BIN/hil/sim/mission/roverd-sim" --mapd "$BIN/firmware/mapd/mapd" \
+  --roudi-config firmware/config/roudi.toml --config firmware/config/sim.yaml \
+  --evaluate-map "$OUT" --run-dir "$OUT/run" -- \
+  --sim figure-eight-soak --seed "$SEED" --out "$OUT" > "$RUN_LOG" 2>&1 &
+LAUNCH=$!
+
+rss_kb() {  # RSS of the newest process named $1 that is a descendant of this run
+  local pid
+  pid=$(pgrep -n -f "$1" || true)
+  [[ -n "$pid" ]] && awk '/^VmRSS:/ { print $2 }' "/proc/$pid/status" 2>/dev/null || echo 0
+}
+
+echo "wall_s,roverd_rss_kb,mapd_rss_kb" > "$OUT/rss.csv"
+START=$(date +%s)
+while kill -0 "$LAUNCH" 2>/dev/null; do
+  sleep "$PERIOD_S"
+  now=$(( $(date +%s) - START ))
+  r=$(rss_kb "roverd-sim --ipc")
+  m=$(rss_kb "firmware/mapd/mapd")
+  echo "$now,$r,$m" >> "$OUT/rss.csv"
+  printf 'soak: %5d s  roverd %7d kB  mapd %7d kB  %s\n' "$now" "$r" "$m" \
+    "$(grep -a '^t ' "$RUN_LOG" | tail -1 | cut -c1-40)"
+done
+wait "$LAUNCH" || true
+
+RESULT=$(grep -a '^RESULT' "$RUN_LOG" | tail -1 || true)
+echo "$RESULT"
+# Growth after the warm-up: the last sample against the first one after it
+# (and the largest after it, in case memory came back down).
+awk -F, -v warm="$WARMUP_S" -v max="$MAX_GROWTH_PCT" '
+  NR == 1 { next }
+  $2 == 0 || $3 == 0 { next }
+  $1 >= warm && !base { base = 1; r0 = $2; m0 = $3 }
+  base { r1 = $2; m1 = $3; if ($2 > rmax) rmax = $2; if ($3 > mmax) mmax = $3 }
+  END {
+    if (!base) { print "soak: the run ended before the warm-up: no growth figure"; exit 1 }
+    rg = 100 * (rmax - r0) / r0; mg = 100 * (mmax - m0) / m0
+    printf "soak: after %d s: roverd %d -> %d kB (max %d, %+.1f %%), mapd %d -> %d kB (max %d, %+.1f %%)\n", warm, r0, r1, rmax, rg, m0, m1, mmax, mg
+    exit (rg > max || mg > max) ? 1 : 0
+  }' "$OUT/rss.csv" | tee "$OUT/summary.txt"
+growth=${PIPESTATUS[0]}
+drops_ok=1
+[[ "$RESULT" =~ imu_drops=0\  && "$RESULT" =~ frame_drops=0\  ]] || drops_ok=0
+if [[ $growth -ne 0 || $drops_ok -ne 1 ]]; then
+  echo "soak: FAILED (memory growth above ${MAX_GROWTH_PCT} % or drops; see $OUT)" | tee -a "$OUT/summary.txt"
+  exit 1
+fi
+echo "soak: passed" | tee -a "$OUT/summary.txt"
