@@ -567,7 +567,7 @@ void Mapd::LogAndSubmit(const log::rover_msgs::GraphFactor& msg) {
   }
 }
 
-void Mapd::PublishGraphState(const SlamSnapshot& snap) {
+void Mapd::PublishOrigins(const SlamSnapshot& snap) {
   const uint32_t total = static_cast<uint32_t>(snap.origins.size());
   const uint32_t per_page = topics::SubmapOriginsMsg::kMaxOrigins;
   const uint32_t pages = std::max(1u, (total + per_page - 1) / per_page);
@@ -592,18 +592,20 @@ void Mapd::PublishGraphState(const SlamSnapshot& snap) {
       }
     }) && sent;
   }
-  if (snap.T_world_body) {
-    sent = global_pose_->PublishInPlace([&](topics::GlobalPoseMsg& m) {
-      m.version = topics::kTopicsVersion;
-      m.robot = options_.robot_id;
-      m.stamp_ns = snap.global_pose_stamp_ns;
-      m.update = snap.update;
-      m.frame_id = snap.global_pose_frame_id;
-      FillPose(*snap.T_world_body, &m.p_world_body_m, &m.q_world_body_wxyz);
-      FillCovariance(snap.global_pose_covariance, &m.covariance);
-    }) && sent;
-  }
   if (sent) ++stats_.graph_states_published;
+}
+
+void Mapd::PublishGlobalPose(const SlamSnapshot& snap) {
+  const bool sent = global_pose_->PublishInPlace([&](topics::GlobalPoseMsg& m) {
+    m.version = topics::kTopicsVersion;
+    m.robot = options_.robot_id;
+    m.stamp_ns = snap.global_pose_stamp_ns;
+    m.update = snap.update;
+    m.frame_id = snap.global_pose_frame_id;
+    FillPose(*snap.T_world_body, &m.p_world_body_m, &m.q_world_body_wxyz);
+    FillCovariance(snap.global_pose_covariance, &m.covariance);
+  });
+  if (!sent) ++stats_.graph_publish_drops;
 }
 
 void Mapd::TakeLoopMatches() {
@@ -643,9 +645,21 @@ void Mapd::TakeSlamSnapshot() {
   const SlamSnapshot snap = slam_->Latest();
   if (snap.update == last_snapshot_update_) return;
   last_snapshot_update_ = snap.update;
-  PublishGraphState(snap);
-  if (loop_) loop_->UpdateOrigins(snap.origins);
-  if (!archive_) return;
+  // Origins change only when factors are added; the global pose follows
+  // every estimate handed over.
+  if (snap.origins_update != last_origins_update_) {
+    last_origins_update_ = snap.origins_update;
+    PublishOrigins(snap);
+    if (loop_) loop_->UpdateOrigins(snap.origins);
+    if (archive_) LogOrigins(snap);
+  }
+  if (snap.T_world_body) {
+    PublishGlobalPose(snap);
+    if (archive_) LogGlobalPose(snap);
+  }
+}
+
+void Mapd::LogOrigins(const SlamSnapshot& snap) {
   std::map<int64_t, Eigen::Isometry3d> T_world_frame;
   log::rover_msgs::SubmapOrigins origins;
   origins.header.stamp = log::ToRosTime(Time::FromNanoseconds(snap.stamp_ns));
@@ -662,18 +676,19 @@ void Mapd::TakeSlamSnapshot() {
     origins.origins.push_back(m);
   }
   archive_->SetOrigins(T_world_frame);
-  std::optional<log::geometry_msgs::PoseWithCovarianceStamped> pose;
-  if (snap.T_world_body) {
-    pose.emplace();
-    pose->header.stamp = log::ToRosTime(Time::FromNanoseconds(snap.global_pose_stamp_ns));
-    pose->header.frame_id = log::FrameId::Truncated("world");
-    pose->pose.pose = mapping::ToPoseMsg(*snap.T_world_body);
-    const mapping::Matrix6d ros =
-        mapping::RosPoseCovariance(snap.T_world_body->linear(), snap.global_pose_covariance);
-    for (int i = 0; i < 36; ++i)
-      pose->pose.covariance[static_cast<std::size_t>(i)] = ros(i / 6, i % 6);
-  }
-  archive_->LogGraphState(origins, pose);
+  archive_->LogOrigins(origins);
+}
+
+void Mapd::LogGlobalPose(const SlamSnapshot& snap) {
+  log::geometry_msgs::PoseWithCovarianceStamped pose;
+  pose.header.stamp = log::ToRosTime(Time::FromNanoseconds(snap.global_pose_stamp_ns));
+  pose.header.frame_id = log::FrameId::Truncated("world");
+  pose.pose.pose = mapping::ToPoseMsg(*snap.T_world_body);
+  const mapping::Matrix6d ros =
+      mapping::RosPoseCovariance(snap.T_world_body->linear(), snap.global_pose_covariance);
+  for (int i = 0; i < 36; ++i)
+    pose.pose.covariance[static_cast<std::size_t>(i)] = ros(i / 6, i % 6);
+  archive_->LogGlobalPose(pose);
 }
 
 MapdBandwidth Mapd::Bandwidth() const {

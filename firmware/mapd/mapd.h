@@ -119,7 +119,8 @@ struct MapdStats {
   uint64_t cloud_bytes = 0;       ///< serialised sensor_msgs/PointCloud2 of finished submaps
   uint64_t obstacle_points = 0;
   uint64_t grids_published = 0;
-  uint64_t graph_states_published = 0;  ///< updates whose origins and pose went out
+  uint64_t graph_states_published = 0;  ///< origin updates that went out whole
+  uint64_t graph_publish_drops = 0;     ///< global poses not published (no chunk)
   uint64_t graph_factors_refused = 0;   ///< malformed before reaching the graph (NaN, ...)
   uint64_t graph_factors_resumed = 0;   ///< taken over from the previous mapd's log
   uint64_t loop_closures = 0;           ///< accepted matches added to the graph
@@ -206,8 +207,13 @@ class Mapd {
   void TakeSlamSnapshot();
   /// Hands the newest estimate to the graph thread for the global pose.
   void HandLatestPose();
-  /// Publishes the snapshot's origins (in pages) and global pose.
-  void PublishGraphState(const SlamSnapshot& snap);
+  /// Publishes the snapshot's origins (in pages), and its global pose.
+  void PublishOrigins(const SlamSnapshot& snap);
+  void PublishGlobalPose(const SlamSnapshot& snap);
+  /// Logs the snapshot's origins (and moves the composed submaps), and its
+  /// global pose.
+  void LogOrigins(const SlamSnapshot& snap);
+  void LogGlobalPose(const SlamSnapshot& snap);
   /// Adds the loop closer's accepted matches to the graph.
   void TakeLoopMatches();
 
@@ -238,6 +244,7 @@ class Mapd {
   bool prior_added_ = false;
   uint64_t next_factor_id_ = 1;
   uint64_t last_snapshot_update_ = 0;
+  uint64_t last_origins_update_ = 0;
   Time last_global_pose_handed_;
   std::optional<runtime::topics::PoseMsg> latest_pose_;  ///< not yet handed over
   std::optional<mapping::GraphLogContents> resume_candidate_;

@@ -187,6 +187,7 @@ void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch) {
     stats_.update_ms.push_back(ms);
   }
   snap.update = latest_.update + 1;
+  snap.origins_update = added > 0 || latest_.update == 0 ? snap.update : latest_.origins_update;
   snap.stamp_ns = std::max(stamp_ns, latest_.stamp_ns);
   snap.update_ms = ms;
   if (added == 0) snap.summary = latest_.summary;

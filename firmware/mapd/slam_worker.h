@@ -35,7 +35,10 @@ struct OptimisedOrigin {
 
 /// The graph's state after one update.
 struct SlamSnapshot {
-  uint64_t update = 0;   ///< 0: no update yet
+  uint64_t update = 0;  ///< 0: no update yet
+  /// The update that last changed the origins (a factor was added); later
+  /// updates only moved the global pose.
+  uint64_t origins_update = 0;
   int64_t stamp_ns = 0;  ///< of the newest factor or pose it includes
   /// By the filter's local frame id (robot 0's origins).
   std::map<int64_t, OptimisedOrigin> origins;

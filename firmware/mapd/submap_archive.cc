@@ -105,16 +105,15 @@ void SubmapArchive::LogFactor(const log::rover_msgs::GraphFactor& factor) {
   log_->Flush();
 }
 
-void SubmapArchive::LogGraphState(
-    const log::rover_msgs::SubmapOrigins& origins,
-    const std::optional<log::geometry_msgs::PoseWithCovarianceStamped>& pose) {
+void SubmapArchive::LogOrigins(const log::rover_msgs::SubmapOrigins& origins) {
   if (!log_) return;
   log_->Write(mapping::kSubmapOriginsTopic, log::FromRosTime(origins.header.stamp).nanoseconds(),
               origins);
-  if (pose) {
-    log_->Write(mapping::kGlobalPoseTopic, log::FromRosTime(pose->header.stamp).nanoseconds(),
-                *pose);
-  }
+}
+
+void SubmapArchive::LogGlobalPose(const log::geometry_msgs::PoseWithCovarianceStamped& pose) {
+  if (!log_) return;
+  log_->Write(mapping::kGlobalPoseTopic, log::FromRosTime(pose.header.stamp).nanoseconds(), pose);
 }
 
 void SubmapArchive::SetOrigins(const std::map<int64_t, Eigen::Isometry3d>& T_world_frame) {

@@ -55,9 +55,10 @@ class SubmapArchive {
   /// Logs one pose-graph factor and flushes it to disk (a crash from then on
   /// keeps it).
   void LogFactor(const log::rover_msgs::GraphFactor& factor);
-  /// Logs the graph's origins and the global pose after an update.
-  void LogGraphState(const log::rover_msgs::SubmapOrigins& origins,
-                     const std::optional<log::geometry_msgs::PoseWithCovarianceStamped>& pose);
+  /// Logs the graph's origins after an update that changed them.
+  void LogOrigins(const log::rover_msgs::SubmapOrigins& origins);
+  /// Logs the global pose after an update.
+  void LogGlobalPose(const log::geometry_msgs::PoseWithCovarianceStamped& pose);
   /// Places the submaps at the pose graph's origins (T_world_frame by local
   /// frame id): archived submaps move in the composed map, later ones are
   /// placed there. The map frame stays the first submap's frame.

@@ -196,6 +196,9 @@ TEST(LoopCloserOptionsTest, InvalidOptionsNameTheKey) {
   EXPECT_EQ(loaded.max_queued_pairs, 4);
   EXPECT_EQ(loaded.nice_increment, 5);
   EXPECT_EQ(loaded.matcher.mode, mapping::MatchMode::kSixDof);
+  // Keys a child map does not name keep mapd's defaults.
+  EXPECT_EQ(loaded.matcher.min_bound_m, LoopCloserOptions{}.matcher.min_bound_m);
+  EXPECT_GT(loaded.matcher.min_bound_m, mapping::SubmapMatcherOptions{}.min_bound_m);
 }
 
 }  // namespace
