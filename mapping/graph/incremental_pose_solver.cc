@@ -1,0 +1,526 @@
+#include "mapping/graph/incremental_pose_solver.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <map>
+#include <queue>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "mapping/graph/pose_manifold.h"
+#include "mapping/graph/relative_pose_3d_cost.h"
+
+namespace rover::mapping {
+namespace {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using RowJacobian = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
+
+// A vector indexed by the solver's int variable / position / factor indices.
+template <class T>
+struct IVec : std::vector<T> {
+  using Base = std::vector<T>;
+  using Base::Base;
+  explicit IVec(int n) : Base(static_cast<size_t>(n)) {}
+  IVec(int n, const T& value) : Base(static_cast<size_t>(n), value) {}
+  void assign(int n, const T& value) { Base::assign(static_cast<size_t>(n), value); }
+  void reserve(int n) { Base::reserve(static_cast<size_t>(n)); }
+  T& operator[](int i) { return Base::operator[](static_cast<size_t>(i)); }
+  const T& operator[](int i) const { return Base::operator[](static_cast<size_t>(i)); }
+  T& operator[](size_t i) { return Base::operator[](i); }
+  const T& operator[](size_t i) const { return Base::operator[](i); }
+};
+
+double MaxStep(const Vector6d& d) { return d.cwiseAbs().maxCoeff(); }
+
+}  // namespace
+
+class IncrementalPoseSolver::Impl {
+ public:
+  explicit Impl(const IncrementalPoseSolverOptions& options) : options_(options) {}
+
+  struct Variable {
+    std::array<double, 7> theta{};
+    Vector6d delta = Vector6d::Zero();
+    IVec<int> factors;
+    std::set<int> neighbours;
+  };
+
+  struct Factor {
+    int a = -1;
+    int b = -1;  // -1: prior
+    std::unique_ptr<RelativePose3dCost> between;
+    std::unique_ptr<PosePrior3dCost> prior;
+    bool robust = false;
+    // Whitened (and IRLS-weighted) linearisation at theta.
+    Matrix6d J_a = Matrix6d::Zero();
+    Matrix6d J_b = Matrix6d::Zero();
+    Vector6d r = Vector6d::Zero();
+    double cost = 0.0;  // 1/2 rho(|r|^2), unweighted r
+  };
+
+  // Linearises factor k at the theta of its variables; returns false if the
+  // cost function fails (never for these residuals).
+  void Linearize(int k) {
+    Factor& f = factors_[k];
+    RowJacobian Ja, Jb;
+    Vector6d r;
+    if (f.b < 0) {
+      const double* params[1] = {variables_[f.a].theta.data()};
+      double* jac[1] = {Ja.data()};
+      f.prior->Evaluate(params, r.data(), jac);
+      Jb.setZero();
+    } else {
+      const double* params[2] = {variables_[f.a].theta.data(), variables_[f.b].theta.data()};
+      double* jac[2] = {Ja.data(), Jb.data()};
+      f.between->Evaluate(params, r.data(), jac);
+    }
+    const double s = r.squaredNorm();
+    double w = 1.0;
+    if (f.robust) {
+      const double c2 = options_.cauchy_scale * options_.cauchy_scale;
+      w = 1.0 / (1.0 + s / c2);
+      f.cost = 0.5 * c2 * std::log1p(s / c2);
+    } else {
+      f.cost = 0.5 * s;
+    }
+    const double sw = std::sqrt(w);
+    f.J_a = sw * Ja.leftCols<6>();
+    f.J_b = sw * Jb.leftCols<6>();
+    f.r = sw * r;
+  }
+
+  // Recomputes the normal-equation blocks touched by the factors in
+  // `relinearized` from all factors (no add/subtract drift) and records the
+  // columns whose values changed.
+  void RecomputeBlocks(const std::set<int>& touched_variables) {
+    for (const int v : touched_variables) {
+      Matrix6d H = Matrix6d::Zero();
+      Vector6d g = Vector6d::Zero();
+      std::map<int, Matrix6d> off;  // H(v, w), w a neighbour
+      for (const int k : variables_[v].factors) {
+        const Factor& f = factors_[k];
+        const bool is_a = f.a == v;
+        const Matrix6d& J = is_a ? f.J_a : f.J_b;
+        H.noalias() += J.transpose() * J;
+        g.noalias() -= J.transpose() * f.r;
+        if (f.b >= 0) {
+          const int w = is_a ? f.b : f.a;
+          const Matrix6d& Jw = is_a ? f.J_b : f.J_a;
+          auto [it, inserted] = off.try_emplace(w, Matrix6d::Zero());
+          it->second.noalias() += J.transpose() * Jw;
+        }
+      }
+      H_diag_[v] = H;
+      b_[v] = g;
+      for (auto& [w, block] : off) {
+        // Store H(min, max) once.
+        if (v < w) {
+          H_off_[{v, w}] = block;
+        } else {
+          H_off_[{w, v}] = block.transpose();
+        }
+        changed_columns_.insert(std::min(pos_[v], pos_[w]));
+      }
+      changed_columns_.insert(pos_[v]);
+    }
+  }
+
+  Matrix6d HBlock(int row_var, int col_var) const {
+    if (row_var < col_var) return H_off_.at({row_var, col_var});
+    return H_off_.at({col_var, row_var}).transpose();
+  }
+
+  // Nested dissection by breadth-first level structures: split a connected
+  // part at the middle level of a BFS from a pseudo-peripheral node, order
+  // both halves recursively, then the separator.
+  void Dissect(IVec<int> nodes, IVec<int>* order, IVec<int>* mark, IVec<int>* level, int* stamp) {
+    if (nodes.size() <= 4) {
+      order->insert(order->end(), nodes.begin(), nodes.end());
+      return;
+    }
+    const int id = ++*stamp;
+    for (const int v : nodes) (*mark)[v] = id;
+    const auto bfs = [&](int start, IVec<int>* reached) {
+      const int visit = ++*stamp;
+      reached->clear();
+      reached->push_back(start);
+      (*mark)[start] = visit;
+      (*level)[start] = 0;
+      for (size_t h = 0; h < reached->size(); ++h) {
+        const int u = (*reached)[h];
+        for (const int w : variables_[u].neighbours) {
+          if ((*mark)[w] != id) continue;
+          (*mark)[w] = visit;
+          (*level)[w] = (*level)[u] + 1;
+          reached->push_back(w);
+        }
+      }
+      for (const int v : *reached) (*mark)[v] = id;
+      return visit;
+    };
+    IVec<int> reached;
+    bfs(nodes.front(), &reached);
+    bfs(reached.back(), &reached);
+    if (reached.size() < nodes.size()) {
+      // Disconnected: the reached component and the rest are independent.
+      IVec<int> rest;
+      const int in = ++*stamp;
+      for (const int v : reached) (*mark)[v] = in;
+      for (const int v : nodes) {
+        if ((*mark)[v] != in) rest.push_back(v);
+      }
+      Dissect(reached, order, mark, level, stamp);
+      Dissect(rest, order, mark, level, stamp);
+      return;
+    }
+    const int depth = (*level)[reached.back()];
+    if (depth < 2) {
+      order->insert(order->end(), nodes.begin(), nodes.end());
+      return;
+    }
+    const int middle = depth / 2;
+    IVec<int> a, b, separator;
+    for (const int v : reached) {
+      const int l = (*level)[v];
+      (l < middle ? a : l > middle ? b : separator).push_back(v);
+    }
+    Dissect(a, order, mark, level, stamp);
+    Dissect(b, order, mark, level, stamp);
+    order->insert(order->end(), separator.begin(), separator.end());
+  }
+
+  void Reorder() {
+    const int n = static_cast<int>(variables_.size());
+    IVec<int> all(n), order, mark(n, 0), level(n, 0);
+    for (int v = 0; v < n; ++v) all[v] = v;
+    int stamp = 0;
+    order.reserve(n);
+    Dissect(all, &order, &mark, &level, &stamp);
+    var_at_ = order;
+    pos_.assign(n, 0);
+    for (int k = 0; k < n; ++k) pos_[var_at_[k]] = k;
+    structure_.assign(n, {});
+    L_.assign(n, {});
+    L_diag_.assign(n, Matrix6d::Zero());
+    parent_.assign(n, -1);
+    children_.assign(n, {});
+    rows_.assign(n, {});
+    changed_columns_.clear();
+    for (int k = 0; k < n; ++k) changed_columns_.insert(k);
+    appended_since_reorder_ = 0;
+    ordered_ = true;
+  }
+
+  // Left-looking block Cholesky of column k given the final columns of its
+  // descendants: L_kk L_kk^T = H_kk - sum_j L_kj L_kj^T and
+  // L_ik = (H_ik - sum_j L_ij L_kj^T) L_kk^-T over j with L_kj != 0.
+  // Returns the rows of the old structure that left it.
+  IVec<int> FactorColumn(int k) {
+    const int v = var_at_[k];
+    IVec<int> structure;
+    for (const int w : variables_[v].neighbours) {
+      if (pos_[w] > k) structure.push_back(pos_[w]);
+    }
+    for (const int c : children_[k]) {
+      for (const int i : structure_[c]) {
+        if (i != k) structure.push_back(i);
+      }
+    }
+    std::sort(structure.begin(), structure.end());
+    structure.erase(std::unique(structure.begin(), structure.end()), structure.end());
+    IVec<int> dropped;
+    std::set_difference(structure_[k].begin(), structure_[k].end(), structure.begin(),
+                        structure.end(), std::back_inserter(dropped));
+    for (const int i : dropped) rows_[i].erase(k);
+    for (const int i : structure) rows_[i].insert(k);
+    structure_[k] = std::move(structure);
+
+    // Dense scratch indexed by position.
+    const IVec<int>& s = structure_[k];
+    for (size_t t = 0; t < s.size(); ++t) {
+      slot_[s[t]] = static_cast<int>(t);
+    }
+    IVec<Matrix6d> acc(s.size(), Matrix6d::Zero());
+    Matrix6d diag = H_diag_[v];
+    for (const int w : variables_[v].neighbours) {
+      if (pos_[w] > k) acc[slot_[pos_[w]]] = HBlock(w, v);
+    }
+    for (const int j : rows_[k]) {
+      const IVec<int>& sj = structure_[j];
+      const auto it = std::lower_bound(sj.begin(), sj.end(), k);
+      size_t t = static_cast<size_t>(it - sj.begin());
+      const Matrix6d L_kj = L_[j][t];
+      diag.noalias() -= L_kj * L_kj.transpose();
+      for (++t; t < sj.size(); ++t) {
+        acc[slot_[sj[t]]].noalias() -= L_[j][t] * L_kj.transpose();
+      }
+    }
+    const Eigen::LLT<Matrix6d> llt(0.5 * (diag + diag.transpose()));
+    if (llt.info() != Eigen::Success) {
+      throw std::runtime_error(
+          "incremental solver: normal matrix not positive definite (unconstrained variable?)");
+    }
+    L_diag_[k] = llt.matrixL();
+    const auto Lkk = L_diag_[k].triangularView<Eigen::Lower>();
+    for (Matrix6d& block : acc) {
+      // X L_kk^T = A  <=>  L_kk X^T = A^T.
+      block = Lkk.solve(block.transpose()).transpose();
+    }
+    L_[k] = std::move(acc);
+    const int parent = s.empty() ? -1 : s.front();
+    if (parent != parent_[k]) {
+      if (parent_[k] >= 0) {
+        auto& c = children_[parent_[k]];
+        c.erase(std::find(c.begin(), c.end(), k));
+      }
+      if (parent >= 0) children_[parent].push_back(k);
+      parent_[k] = parent;
+    }
+    return dropped;
+  }
+
+  // Re-factors the changed columns and all their ancestors (old and new
+  // elimination tree), in increasing position order.
+  int Refactor() {
+    std::priority_queue<int, IVec<int>, std::greater<>> queue;
+    for (const int k : changed_columns_) queue.push(k);
+    changed_columns_.clear();
+    int last = -1, count = 0;
+    while (!queue.empty()) {
+      const int k = queue.top();
+      queue.pop();
+      if (k == last) continue;
+      last = k;
+      ++count;
+      const int old_parent = parent_[k];
+      for (const int i : FactorColumn(k)) queue.push(i);
+      if (old_parent >= 0) queue.push(old_parent);
+      if (parent_[k] >= 0) queue.push(parent_[k]);
+    }
+    return count;
+  }
+
+  void SolveDelta() {
+    const int n = static_cast<int>(variables_.size());
+    IVec<Vector6d> y(n);
+    for (int k = 0; k < n; ++k) y[k] = b_[var_at_[k]];
+    for (int k = 0; k < n; ++k) {
+      L_diag_[k].triangularView<Eigen::Lower>().solveInPlace(y[k]);
+      const IVec<int>& s = structure_[k];
+      for (size_t t = 0; t < s.size(); ++t) y[s[t]].noalias() -= L_[k][t] * y[k];
+    }
+    for (int k = n - 1; k >= 0; --k) {
+      const IVec<int>& s = structure_[k];
+      for (size_t t = 0; t < s.size(); ++t) y[k].noalias() -= L_[k][t].transpose() * y[s[t]];
+      L_diag_[k].transpose().triangularView<Eigen::Upper>().solveInPlace(y[k]);
+      variables_[var_at_[k]].delta = y[k];
+    }
+  }
+
+  IncrementalPoseSolverStats Update() {
+    IncrementalPoseSolverStats stats;
+    const bool batch = options_.reorder_interval == 0;
+    if (batch || !ordered_ || appended_since_reorder_ >= options_.reorder_interval) {
+      Reorder();
+      stats.reordered = true;
+    }
+    std::set<int> touched;
+    for (const int k : pending_factors_) {
+      Linearize(k);
+      touched.insert(factors_[k].a);
+      if (factors_[k].b >= 0) touched.insert(factors_[k].b);
+    }
+    pending_factors_.clear();
+    const double threshold = std::max(options_.relinearize_threshold, options_.step_tolerance);
+    for (stats.iterations = 0; stats.iterations < options_.max_iterations; ++stats.iterations) {
+      RecomputeBlocks(touched);
+      touched.clear();
+      stats.refactored_columns += Refactor();
+      SolveDelta();
+      // Fluid relinearisation: only variables whose step is large enough.
+      std::set<int> moved;
+      double max_step = 0.0;
+      for (int v = 0; v < static_cast<int>(variables_.size()); ++v) {
+        const double step = MaxStep(variables_[v].delta);
+        max_step = std::max(max_step, step);
+        if (step > threshold || (options_.relinearize_threshold == 0.0 && step > 0.0)) {
+          moved.insert(v);
+        }
+      }
+      if (max_step <= threshold) {
+        stats.converged = true;
+        ++stats.iterations;
+        break;
+      }
+      std::set<int> relinearize;
+      for (const int v : moved) {
+        Variable& var = variables_[v];
+        std::array<double, 7> x;
+        manifold_.Plus(var.theta.data(), var.delta.data(), x.data());
+        var.theta = x;
+        var.delta.setZero();
+        for (const int k : var.factors) relinearize.insert(k);
+      }
+      stats.relinearized_variables += static_cast<int>(moved.size());
+      for (const int k : relinearize) {
+        Linearize(k);
+        touched.insert(factors_[k].a);
+        if (factors_[k].b >= 0) touched.insert(factors_[k].b);
+      }
+    }
+    return stats;
+  }
+
+  Matrix6d MarginalCovariance(int v) const {
+    // Y = L^-1 E_v is non-zero only on v's path to the root.
+    std::map<int, Matrix6d> acc;
+    acc[pos_[v]] = Matrix6d::Identity();
+    Matrix6d sigma = Matrix6d::Zero();
+    while (!acc.empty()) {
+      const auto it = acc.begin();
+      const int q = it->first;
+      Matrix6d Y = L_diag_[q].triangularView<Eigen::Lower>().solve(it->second);
+      acc.erase(it);
+      sigma.noalias() += Y.transpose() * Y;
+      const IVec<int>& s = structure_[q];
+      for (size_t t = 0; t < s.size(); ++t) {
+        auto [jt, inserted] = acc.try_emplace(s[t], Matrix6d::Zero());
+        jt->second.noalias() -= L_[q][t] * Y;
+      }
+    }
+    return 0.5 * (sigma + sigma.transpose());
+  }
+
+  const IncrementalPoseSolverOptions options_;
+  PoseManifold manifold_;
+  IVec<Variable> variables_;
+  IVec<Factor> factors_;
+  IVec<int> pending_factors_;
+  // Normal equations H delta = b over the variables (index space).
+  IVec<Matrix6d> H_diag_;
+  IVec<Vector6d> b_;
+  std::map<std::pair<int, int>, Matrix6d> H_off_;
+  // Factor L (position space): column k holds rows structure_[k] (> k).
+  IVec<int> var_at_, pos_;
+  IVec<IVec<int>> structure_;
+  IVec<IVec<Matrix6d>> L_;
+  IVec<Matrix6d> L_diag_;
+  IVec<int> parent_;
+  IVec<IVec<int>> children_;
+  IVec<std::set<int>> rows_;
+  IVec<int> slot_;
+  std::set<int> changed_columns_;
+  int appended_since_reorder_ = 0;
+  bool ordered_ = false;
+};
+
+IncrementalPoseSolver::IncrementalPoseSolver(const IncrementalPoseSolverOptions& options)
+    : impl_(std::make_unique<Impl>(options)) {}
+
+IncrementalPoseSolver::~IncrementalPoseSolver() = default;
+
+int IncrementalPoseSolver::AddVariable(const double* x) {
+  Impl& m = *impl_;
+  const int v = static_cast<int>(m.variables_.size());
+  Impl::Variable var;
+  std::copy(x, x + 7, var.theta.begin());
+  m.variables_.push_back(std::move(var));
+  m.H_diag_.push_back(Matrix6d::Zero());
+  m.b_.push_back(Vector6d::Zero());
+  m.slot_.push_back(0);
+  if (m.ordered_) {
+    // Appended at the end of the current ordering until the next re-order.
+    m.pos_.push_back(static_cast<int>(m.var_at_.size()));
+    m.var_at_.push_back(v);
+    m.structure_.emplace_back();
+    m.L_.emplace_back();
+    m.L_diag_.push_back(Matrix6d::Zero());
+    m.parent_.push_back(-1);
+    m.children_.emplace_back();
+    m.rows_.emplace_back();
+    m.changed_columns_.insert(m.pos_.back());
+    ++m.appended_since_reorder_;
+  }
+  return v;
+}
+
+void IncrementalPoseSolver::AddFactor(int a, int b, const Eigen::Isometry3d& Z,
+                                      const Matrix6d& information, bool robust) {
+  Impl& m = *impl_;
+  const int n = static_cast<int>(m.variables_.size());
+  if (a < 0 || a >= n || b >= n || a == b) {
+    throw std::invalid_argument("incremental solver: factor between variables " +
+                                std::to_string(a) + " and " + std::to_string(b) +
+                                ", expected indices below " + std::to_string(n));
+  }
+  Impl::Factor f;
+  f.a = a;
+  f.b = b;
+  f.robust = robust;
+  if (b < 0) {
+    f.prior = std::make_unique<PosePrior3dCost>(Z, information);
+  } else {
+    f.between = std::make_unique<RelativePose3dCost>(Z, information);
+    m.variables_[a].neighbours.insert(b);
+    m.variables_[b].neighbours.insert(a);
+  }
+  const int k = static_cast<int>(m.factors_.size());
+  m.variables_[a].factors.push_back(k);
+  if (b >= 0) m.variables_[b].factors.push_back(k);
+  m.factors_.push_back(std::move(f));
+  m.pending_factors_.push_back(k);
+}
+
+IncrementalPoseSolverStats IncrementalPoseSolver::Update() { return impl_->Update(); }
+
+void IncrementalPoseSolver::Estimate(int v, double* x) const {
+  const Impl::Variable& var = impl_->variables_.at(static_cast<size_t>(v));
+  impl_->manifold_.Plus(var.theta.data(), var.delta.data(), x);
+}
+
+void IncrementalPoseSolver::ResetLinearization(const std::vector<const double*>& x_of) {
+  Impl& m = *impl_;
+  for (size_t v = 0; v < m.variables_.size(); ++v) {
+    std::copy(x_of[v], x_of[v] + 7, m.variables_[v].theta.begin());
+    m.variables_[v].delta.setZero();
+  }
+  m.pending_factors_.clear();
+  for (size_t k = 0; k < m.factors_.size(); ++k) m.pending_factors_.push_back(static_cast<int>(k));
+  m.ordered_ = false;  // re-order at the next Update()
+}
+
+IncrementalPoseSolver::Matrix6d IncrementalPoseSolver::MarginalCovariance(int v) const {
+  return impl_->MarginalCovariance(v);
+}
+
+double IncrementalPoseSolver::LinearizedCost() const {
+  double cost = 0.0;
+  for (const auto& f : impl_->factors_) cost += f.cost;
+  return cost;
+}
+
+std::vector<int> IncrementalPoseSolver::Neighbourhood(const std::vector<int>& seeds,
+                                                      int hops) const {
+  std::set<int> reached(seeds.begin(), seeds.end());
+  std::vector<int> frontier(seeds.begin(), seeds.end());
+  for (int h = 0; h < hops && !frontier.empty(); ++h) {
+    std::vector<int> next;
+    for (const int v : frontier) {
+      for (const int w : impl_->variables_[v].neighbours) {
+        if (reached.insert(w).second) next.push_back(w);
+      }
+    }
+    frontier = std::move(next);
+  }
+  return {reached.begin(), reached.end()};
+}
+
+int IncrementalPoseSolver::num_variables() const {
+  return static_cast<int>(impl_->variables_.size());
+}
+
+}  // namespace rover::mapping
