@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <queue>
 #include <set>
@@ -59,7 +61,10 @@ class IncrementalPoseSolver::Impl {
     Matrix6d J_a = Matrix6d::Zero();
     Matrix6d J_b = Matrix6d::Zero();
     Vector6d r = Vector6d::Zero();
-    double cost = 0.0;  // 1/2 rho(|r|^2), unweighted r
+    // Model Hessian weight: the factor adds J^T M J to H and -rho' J^T r to b.
+    Matrix6d M = Matrix6d::Identity();
+    double rho1 = 1.0;
+    double cost = 0.0;  // 1/2 rho(|r|^2)
   };
 
   // Linearises factor k at the theta of its variables; returns false if the
@@ -79,18 +84,31 @@ class IncrementalPoseSolver::Impl {
       f.between->Evaluate(params, r.data(), jac);
     }
     const double s = r.squaredNorm();
-    double w = 1.0;
-    if (f.robust) {
-      const double c2 = options_.cauchy_scale * options_.cauchy_scale;
-      w = 1.0 / (1.0 + s / c2);
-      f.cost = 0.5 * c2 * std::log1p(s / c2);
-    } else {
+    f.J_a = Ja.leftCols<6>();
+    f.J_b = Jb.leftCols<6>();
+    f.r = r;
+    if (!f.robust) {
       f.cost = 0.5 * s;
+      f.M.setIdentity();
+      f.rho1 = 1.0;
+      return;
     }
-    const double sw = std::sqrt(w);
-    f.J_a = sw * Ja.leftCols<6>();
-    f.J_b = sw * Jb.leftCols<6>();
-    f.r = sw * r;
+    // Cauchy: the Hessian of 1/2 rho(|r|^2) is J^T (rho' I + 2 rho'' r r^T) J.
+    // Plain reweighting (rho' J^T J) drops the second term and converges only
+    // linearly (inlier loop closures sit near u = s / c^2 ~ 1, where rho'
+    // changes fast); the term is kept: along r the weight is
+    // rho' + 2 rho'' s = rho' (1 - u) / (1 + u), negative in the concave part
+    // of rho (u > 1). If that makes H indefinite, the update falls back to
+    // flooring it at 0 (exact_robust_hessian_ = false); the gradient
+    // rho' J^T r, hence the fixed point, is the same either way.
+    const double c2 = options_.cauchy_scale * options_.cauchy_scale;
+    const double u = s / c2;
+    f.cost = 0.5 * c2 * std::log1p(u);
+    f.rho1 = 1.0 / (1.0 + u);
+    double curvature = (1.0 - u) / (1.0 + u);
+    if (!exact_robust_hessian_) curvature = std::max(curvature, 0.0);
+    f.M = f.rho1 * Matrix6d::Identity();
+    if (s > 0.0) f.M += f.rho1 * (curvature - 1.0) * r * r.transpose() / s;
   }
 
   // Recomputes the normal-equation blocks touched by the factors in
@@ -105,13 +123,14 @@ class IncrementalPoseSolver::Impl {
         const Factor& f = factors_[k];
         const bool is_a = f.a == v;
         const Matrix6d& J = is_a ? f.J_a : f.J_b;
-        H.noalias() += J.transpose() * J;
-        g.noalias() -= J.transpose() * f.r;
+        const Matrix6d JtM = J.transpose() * f.M;
+        H.noalias() += JtM * J;
+        g.noalias() -= f.rho1 * (J.transpose() * f.r);
         if (f.b >= 0) {
           const int w = is_a ? f.b : f.a;
           const Matrix6d& Jw = is_a ? f.J_b : f.J_a;
           auto [it, inserted] = off.try_emplace(w, Matrix6d::Zero());
-          it->second.noalias() += J.transpose() * Jw;
+          it->second.noalias() += JtM * Jw;
         }
       }
       H_diag_[v] = H;
@@ -327,6 +346,13 @@ class IncrementalPoseSolver::Impl {
     if (batch || !ordered_ || appended_since_reorder_ >= options_.reorder_interval) {
       Reorder();
       stats.reordered = true;
+      if (!exact_robust_hessian_) {
+        // Everything is re-factored anyway: try the exact curvature again.
+        exact_robust_hessian_ = true;
+        for (int k = 0; k < static_cast<int>(factors_.size()); ++k) {
+          if (factors_[k].robust) pending_factors_.push_back(k);
+        }
+      }
     }
     std::set<int> touched;
     for (const int k : pending_factors_) {
@@ -335,23 +361,31 @@ class IncrementalPoseSolver::Impl {
       if (factors_[k].b >= 0) touched.insert(factors_[k].b);
     }
     pending_factors_.clear();
-    const double threshold = std::max(options_.relinearize_threshold, options_.step_tolerance);
     for (stats.iterations = 0; stats.iterations < options_.max_iterations; ++stats.iterations) {
       RecomputeBlocks(touched);
       touched.clear();
-      stats.refactored_columns += Refactor();
-      SolveDelta();
-      // Fluid relinearisation: only variables whose step is large enough.
-      std::set<int> moved;
-      double max_step = 0.0;
-      for (int v = 0; v < static_cast<int>(variables_.size()); ++v) {
-        const double step = MaxStep(variables_[v].delta);
-        max_step = std::max(max_step, step);
-        if (step > threshold || (options_.relinearize_threshold == 0.0 && step > 0.0)) {
-          moved.insert(v);
+      try {
+        stats.refactored_columns += Refactor();
+      } catch (const std::runtime_error&) {
+        if (!exact_robust_hessian_) throw;
+        // Indefinite with the exact robust curvature: floor it, re-factor all.
+        exact_robust_hessian_ = false;
+        for (int k = 0; k < static_cast<int>(factors_.size()); ++k) {
+          if (!factors_[k].robust) continue;
+          Linearize(k);
+          touched.insert(factors_[k].a);
+          if (factors_[k].b >= 0) touched.insert(factors_[k].b);
         }
+        RecomputeBlocks(touched);
+        touched.clear();
+        for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
+        stats.refactored_columns += Refactor();
+        ++stats.floored_robust_hessian;
       }
-      if (max_step <= threshold) {
+      SolveDelta();
+      const std::set<int> moved = VariablesToRelinearize();
+
+      if (moved.empty()) {
         stats.converged = true;
         ++stats.iterations;
         break;
@@ -373,6 +407,39 @@ class IncrementalPoseSolver::Impl {
       }
     }
     return stats;
+  }
+
+  // Fluid relinearisation. The residuals are linear in the translations for
+  // fixed rotations (e_t = R_z^T (R_i^T (t_j - t_i) - t_z)), so the linear
+  // model stays exact under translation steps except through the rotation
+  // Jacobian's lever [p]x and the robust weights: a variable is relinearised
+  // when its rotation step exceeds relinearize_rotation_rad or its
+  // translation step relinearize_translation_m, and both variables of a
+  // robust factor when its weight rho' at the predicted residual r + J delta
+  // differs by more than robust_weight_tolerance (relative). With both
+  // thresholds 0 every variable that moves by more than step_tolerance is.
+  std::set<int> VariablesToRelinearize() const {
+    std::set<int> moved;
+    const double rot = std::max(options_.relinearize_rotation_rad, options_.step_tolerance);
+    const double trans = std::max(options_.relinearize_translation_m, options_.step_tolerance);
+    for (int v = 0; v < static_cast<int>(variables_.size()); ++v) {
+      const Vector6d& d = variables_[v].delta;
+      if (d.head<3>().cwiseAbs().maxCoeff() > trans || d.tail<3>().cwiseAbs().maxCoeff() > rot) {
+        moved.insert(v);
+      }
+    }
+    const double c2 = options_.cauchy_scale * options_.cauchy_scale;
+    for (const int k : robust_factors_) {
+      const Factor& f = factors_[k];
+      Vector6d r = f.r + f.J_a * variables_[f.a].delta;
+      if (f.b >= 0) r.noalias() += f.J_b * variables_[f.b].delta;
+      const double rho1 = 1.0 / (1.0 + r.squaredNorm() / c2);
+      if (std::abs(rho1 - f.rho1) > options_.robust_weight_tolerance * f.rho1) {
+        if (MaxStep(variables_[f.a].delta) > options_.step_tolerance) moved.insert(f.a);
+        if (f.b >= 0 && MaxStep(variables_[f.b].delta) > options_.step_tolerance) moved.insert(f.b);
+      }
+    }
+    return moved;
   }
 
   Matrix6d MarginalCovariance(int v) const {
@@ -400,6 +467,7 @@ class IncrementalPoseSolver::Impl {
   IVec<Variable> variables_;
   IVec<Factor> factors_;
   IVec<int> pending_factors_;
+  IVec<int> robust_factors_;
   // Normal equations H delta = b over the variables (index space).
   IVec<Matrix6d> H_diag_;
   IVec<Vector6d> b_;
@@ -416,6 +484,7 @@ class IncrementalPoseSolver::Impl {
   std::set<int> changed_columns_;
   int appended_since_reorder_ = 0;
   bool ordered_ = false;
+  bool exact_robust_hessian_ = true;
 };
 
 IncrementalPoseSolver::IncrementalPoseSolver(const IncrementalPoseSolverOptions& options)
@@ -471,6 +540,7 @@ void IncrementalPoseSolver::AddFactor(int a, int b, const Eigen::Isometry3d& Z,
   const int k = static_cast<int>(m.factors_.size());
   m.variables_[a].factors.push_back(k);
   if (b >= 0) m.variables_[b].factors.push_back(k);
+  if (robust) m.robust_factors_.push_back(k);
   m.factors_.push_back(std::move(f));
   m.pending_factors_.push_back(k);
 }

@@ -15,9 +15,12 @@
 // The ordering is a nested dissection of the factor graph (shallow
 // elimination tree, so few ancestors); new variables are appended at the end
 // and the graph is re-dissected every `reorder_interval` new variables.
-// Robust factors use iteratively reweighted least squares with the Cauchy
-// weight rho'(s) = 1 / (1 + s / c^2): the same stationary points as Ceres's
-// robustified cost 1/2 rho(s).
+// Robust (Cauchy) factors contribute the exact Hessian of 1/2 rho(|r|^2),
+// J^T (rho' I + 2 rho'' r r^T) J, and the gradient rho' J^T r: the same
+// stationary points as Ceres's robustified cost, reached in a few Newton steps
+// where plain reweighting (rho' J^T J) converges linearly. If the negative
+// curvature of a factor in the concave part of rho makes H indefinite, that
+// term is floored at 0 until the next re-ordering.
 // Marginal covariances come from a forward solve along one column's path to
 // the root of the elimination tree: Sigma_vv = Y^T Y, Y = L^-1 E_v.
 
@@ -30,12 +33,17 @@
 namespace rover::mapping {
 
 struct IncrementalPoseSolverOptions {
-  /// A variable is relinearised when its step exceeds this in any component
-  /// ([m] for translation, [rad] for rotation). 0: relinearise every variable
-  /// every iteration (batch Gauss-Newton).
-  double relinearize_threshold = 1e-3;
-  /// Converged once no step component exceeds max(relinearize_threshold,
-  /// step_tolerance).
+  /// A variable is relinearised when the rotation part of its step exceeds
+  /// this [rad] in any component, or the translation part
+  /// relinearize_translation_m [m]. Both 0: every variable that moves is
+  /// relinearised every iteration (batch Gauss-Newton).
+  double relinearize_rotation_rad = 1e-3;
+  double relinearize_translation_m = 1e-3;
+  /// Both variables of a robust factor are relinearised when its weight rho'
+  /// at the predicted residual differs from the linearised one by more than
+  /// this fraction.
+  double robust_weight_tolerance = 0.05;
+  /// Steps below this (any unit) never trigger relinearisation.
   double step_tolerance = 1e-6;
   int max_iterations = 10;
   /// New variables appended at the end of the ordering before the graph is
@@ -52,6 +60,8 @@ struct IncrementalPoseSolverStats {
   int refactored_columns = 0;
   bool reordered = false;
   bool converged = false;
+  /// Times the exact robust curvature made H indefinite and was floored.
+  int floored_robust_hessian = 0;
 };
 
 class IncrementalPoseSolver {

@@ -71,8 +71,10 @@ RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
       node.Get<bool>("compute_origin_covariances", o.compute_origin_covariances);
   o.incremental = node.Get<bool>("incremental", o.incremental);
   o.incremental_solve = node.Get<bool>("incremental_solve", o.incremental_solve);
-  o.relinearize_threshold =
-      node.GetInRange<double>("relinearize_threshold", 0.0, 1.0, o.relinearize_threshold);
+  o.relinearize_rotation_rad =
+      node.GetInRange<double>("relinearize_rotation_rad", 0.0, 1.0, o.relinearize_rotation_rad);
+  o.relinearize_translation_m = node.GetInRange<double>("relinearize_translation_m", 0.0, 100.0,
+                                                        o.relinearize_translation_m);
   o.reorder_interval = node.GetInRange<int>("reorder_interval", 0, 1000000, o.reorder_interval);
   o.covariance_hops = node.GetInRange<int>("covariance_hops", -1, 1000000, o.covariance_hops);
   o.Validate();
@@ -92,8 +94,10 @@ void RoverGraphOptions::Validate() const {
           frame_switch_roll_pitch_sigma_rad);
   require(max_iterations >= 1, "max_iterations", ">= 1", max_iterations);
   require(num_threads >= 1, "num_threads", ">= 1", num_threads);
-  require(relinearize_threshold >= 0.0 && relinearize_threshold <= 1.0, "relinearize_threshold",
-          "in [0, 1]", relinearize_threshold);
+  require(relinearize_rotation_rad >= 0.0 && relinearize_rotation_rad <= 1.0,
+          "relinearize_rotation_rad", "in [0, 1]", relinearize_rotation_rad);
+  require(relinearize_translation_m >= 0.0 && relinearize_translation_m <= 100.0,
+          "relinearize_translation_m", "in [0, 100]", relinearize_translation_m);
   require(reorder_interval >= 0, "reorder_interval", ">= 0", reorder_interval);
   require(covariance_hops >= -1, "covariance_hops", ">= -1", covariance_hops);
 }
@@ -126,7 +130,8 @@ class RoverGraph::Impl {
     options_.Validate();
     if (options_.incremental && options_.incremental_solve) {
       IncrementalPoseSolverOptions io;
-      io.relinearize_threshold = options_.relinearize_threshold;
+      io.relinearize_rotation_rad = options_.relinearize_rotation_rad;
+      io.relinearize_translation_m = options_.relinearize_translation_m;
       io.reorder_interval = options_.reorder_interval;
       io.max_iterations = std::min(options_.max_iterations, 20);
       io.cauchy_scale = options_.cauchy_scale;
@@ -245,7 +250,7 @@ class RoverGraph::Impl {
       for (const Factor* f : pending) {
         if (!f->b) {
           if (f->a.type == GraphKey::Type::kOrigin && origin_covariance_.count(f->a) == 0) {
-            origin_covariance_[f->a] = f->covariance;
+            SetOriginCovariance(f->a, f->covariance);
             progress = true;
           }
           continue;
@@ -260,8 +265,8 @@ class RoverGraph::Impl {
         J_a.bottomRightCorner<3, 3>() = f->Z.linear().transpose();
         Matrix6d J_z = Matrix6d::Identity();
         J_z.topLeftCorner<3, 3>() = R_a;
-        origin_covariance_[b] =
-            J_a * a_cov->second * J_a.transpose() + J_z * f->covariance * J_z.transpose();
+        SetOriginCovariance(
+            b, J_a * CurrentOriginCovariance(f->a) * J_a.transpose() + J_z * f->covariance * J_z.transpose());
         progress = true;
       }
     }
@@ -383,7 +388,7 @@ class RoverGraph::Impl {
       for (const int i : targets) {
         const GraphKey& key = solver_keys_[static_cast<size_t>(i)];
         if (key.type != GraphKey::Type::kOrigin) continue;
-        origin_covariance_[key] = solver_->MarginalCovariance(i);
+        SetOriginCovariance(key, solver_->MarginalCovariance(i));
         ++out.covariances_updated;
       }
       out.covariance_time_s = Seconds(cov_start);
@@ -433,6 +438,23 @@ class RoverGraph::Impl {
     return out;
   }
 
+  // Stores a marginal with the origin's current rotation: the translation
+  // block is over world axes, so a marginal kept while later solves rotate
+  // the origin is re-expressed with the rotation change (OriginCovariance).
+  void SetOriginCovariance(const GraphKey& key, const Matrix6d& covariance) {
+    origin_covariance_[key] = covariance;
+    covariance_rotation_[key] = PoseFromParameters(variables_.at(key).x.data()).linear();
+  }
+
+  Matrix6d CurrentOriginCovariance(const GraphKey& key) const {
+    const auto it = origin_covariance_.find(key);
+    if (it == origin_covariance_.end()) throw GraphError("no covariance for " + key.ToString());
+    Matrix6d G = Matrix6d::Identity();
+    G.topLeftCorner<3, 3>() = PoseFromParameters(variables_.at(key).x.data()).linear() *
+                              covariance_rotation_.at(key).transpose();
+    return G * it->second * G.transpose();
+  }
+
   void ComputeOriginCovariances() {
     ceres::Covariance::Options co;
     co.num_threads = options_.num_threads;
@@ -451,7 +473,7 @@ class RoverGraph::Impl {
       if (key.type != GraphKey::Type::kOrigin || !v.in_problem) continue;
       Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
       covariance.GetCovarianceBlockInTangentSpace(v.x.data(), v.x.data(), C.data());
-      origin_covariance_[key] = C;
+      SetOriginCovariance(key, C);
     }
   }
 
@@ -464,6 +486,7 @@ class RoverGraph::Impl {
   std::map<GraphKey, Variable> variables_;
   std::vector<Factor> factors_;
   std::map<GraphKey, Matrix6d> origin_covariance_;
+  std::map<GraphKey, Eigen::Matrix3d> covariance_rotation_;  // R_world_origin when computed
   std::vector<GraphKey> unanchored_;
   bool solved_once_ = false;
   double last_cost_ = 0.0;
@@ -571,11 +594,7 @@ Eigen::Isometry3d RoverGraph::Estimate(const GraphKey& key) const {
 
 Matrix6d RoverGraph::OriginCovariance(int robot, int64_t submap) const {
   const GraphKey key = GraphKey::Origin(robot, submap);
-  const auto it = impl_->origin_covariance_.find(key);
-  if (it == impl_->origin_covariance_.end()) {
-    throw GraphError("no covariance for " + key.ToString());
-  }
-  return it->second;
+  return impl_->CurrentOriginCovariance(key);
 }
 
 Eigen::Isometry3d RoverGraph::GlobalPose(int robot) const {

@@ -58,9 +58,11 @@ struct RoverGraphOptions {
   /// re-factorisation) instead of a full Ceres solve; the first solve and a
   /// non-converged update fall back to Ceres.
   bool incremental_solve = true;
-  /// Step [m or rad] above which the incremental solver relinearises a
-  /// variable. 0: every variable every iteration (batch Gauss-Newton).
-  double relinearize_threshold = 1e-3;
+  /// Rotation step [rad] and translation step [m] above which the
+  /// incremental solver relinearises a variable (IncrementalPoseSolverOptions).
+  /// Both 0: every variable every iteration (batch Gauss-Newton).
+  double relinearize_rotation_rad = 1e-3;
+  double relinearize_translation_m = 1e-3;
   /// New variables appended to the elimination ordering before it is
   /// recomputed (a full re-factorisation). 0: every update (batch).
   int reorder_interval = 100;
@@ -75,7 +77,8 @@ struct RoverGraphOptions {
 
   /// Keys: cauchy_scale, frame_switch_roll_pitch_sigma_rad, max_iterations,
   /// num_threads, compute_origin_covariances, incremental, incremental_solve,
-  /// relinearize_threshold, reorder_interval, covariance_hops (all optional).
+  /// relinearize_rotation_rad, relinearize_translation_m, reorder_interval,
+  /// covariance_hops (all optional).
   static RoverGraphOptions Load(const ConfigNode& node);
 };
 
