@@ -383,7 +383,12 @@ class IncrementalPoseSolver::Impl {
         ++stats.floored_robust_hessian;
       }
       SolveDelta();
-      const std::set<int> moved = VariablesToRelinearize();
+      std::set<int> moved = VariablesToRelinearize();
+      if (batch && !moved.empty()) {
+        // Batch Gauss-Newton: every variable, every column, every iteration.
+        for (int v = 0; v < static_cast<int>(variables_.size()); ++v) moved.insert(v);
+        for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
+      }
 
       if (moved.empty()) {
         stats.converged = true;

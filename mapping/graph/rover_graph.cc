@@ -73,8 +73,8 @@ RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
   o.incremental_solve = node.Get<bool>("incremental_solve", o.incremental_solve);
   o.relinearize_rotation_rad =
       node.GetInRange<double>("relinearize_rotation_rad", 0.0, 1.0, o.relinearize_rotation_rad);
-  o.relinearize_translation_m = node.GetInRange<double>("relinearize_translation_m", 0.0, 100.0,
-                                                        o.relinearize_translation_m);
+  o.relinearize_translation_m =
+      node.GetInRange<double>("relinearize_translation_m", 0.0, 100.0, o.relinearize_translation_m);
   o.reorder_interval = node.GetInRange<int>("reorder_interval", 0, 1000000, o.reorder_interval);
   o.covariance_hops = node.GetInRange<int>("covariance_hops", -1, 1000000, o.covariance_hops);
   o.Validate();
@@ -265,8 +265,8 @@ class RoverGraph::Impl {
         J_a.bottomRightCorner<3, 3>() = f->Z.linear().transpose();
         Matrix6d J_z = Matrix6d::Identity();
         J_z.topLeftCorner<3, 3>() = R_a;
-        SetOriginCovariance(
-            b, J_a * CurrentOriginCovariance(f->a) * J_a.transpose() + J_z * f->covariance * J_z.transpose());
+        SetOriginCovariance(b, J_a * CurrentOriginCovariance(f->a) * J_a.transpose() +
+                                   J_z * f->covariance * J_z.transpose());
         progress = true;
       }
     }

@@ -20,14 +20,12 @@ Eigen::Isometry3d MakePose(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
   return T;
 }
 
-double TerrainHeight(double x, double y) {
-  return 1.5 * std::sin(x / 15.0) * std::cos(y / 20.0);
-}
+double TerrainHeight(double x, double y) { return 1.5 * std::sin(x / 15.0) * std::cos(y / 20.0); }
 
 }  // namespace
 
-SyntheticSubmapTrajectory MakeSyntheticSubmapTrajectory(
-    const SyntheticSubmapTrajectoryOptions& o, uint32_t seed) {
+SyntheticSubmapTrajectory MakeSyntheticSubmapTrajectory(const SyntheticSubmapTrajectoryOptions& o,
+                                                        uint32_t seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);
   SyntheticSubmapTrajectory out;
@@ -37,8 +35,7 @@ SyntheticSubmapTrajectory MakeSyntheticSubmapTrajectory(
   // border of the area.
   double x = 0.0, y = 0.0, yaw = 0.0;
   for (int i = 0; i < o.submaps; ++i) {
-    out.T_world_origin.push_back(
-        MakePose(Eigen::Vector3d(x, y, TerrainHeight(x, y)), Rz(yaw)));
+    out.T_world_origin.push_back(MakePose(Eigen::Vector3d(x, y, TerrainHeight(x, y)), Rz(yaw)));
     yaw += 0.35 * n01(rng);
     if (std::abs(x) > o.area_half_width_m || std::abs(y) > o.area_half_width_m) {
       const double to_centre = std::atan2(-y, -x);
@@ -62,14 +59,14 @@ SyntheticSubmapTrajectory MakeSyntheticSubmapTrajectory(
     const Eigen::Isometry3d& cur = out.T_world_origin[static_cast<size_t>(j)];
     const Eigen::Isometry3d w_true = prev.inverse() * cur;
     step.T_old_new = MakePose(
-        w_true.translation() + Eigen::Vector3d(w_sigma[0] * n01(rng), w_sigma[1] * n01(rng),
-                                               w_sigma[2] * n01(rng)),
+        w_true.translation() +
+            Eigen::Vector3d(w_sigma[0] * n01(rng), w_sigma[1] * n01(rng), w_sigma[2] * n01(rng)),
         Rz(YawOf(w_true.linear()) + w_sigma[3] * n01(rng)));
     step.w_covariance = w_sigma.cwiseAbs2().asDiagonal();
     for (int k = 0; k < o.filter_poses_per_submap; ++k) {
-      const Eigen::Isometry3d v_true =
-          MakePose(Eigen::Vector3d(o.step_m * unit(rng), 0.3 * n01(rng), 0.1 * n01(rng)),
-                   Rz(0.2 * n01(rng)) * ExpSO3(Eigen::Vector3d(0.05 * n01(rng), 0.05 * n01(rng), 0)));
+      const Eigen::Isometry3d v_true = MakePose(
+          Eigen::Vector3d(o.step_m * unit(rng), 0.3 * n01(rng), 0.1 * n01(rng)),
+          Rz(0.2 * n01(rng)) * ExpSO3(Eigen::Vector3d(0.05 * n01(rng), 0.05 * n01(rng), 0)));
       step.T_local_body.push_back(MakePose(
           v_true.translation() + 0.02 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)),
           v_true.linear() * ExpSO3(0.002 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng)))));
@@ -78,8 +75,8 @@ SyntheticSubmapTrajectory MakeSyntheticSubmapTrajectory(
     if (o.loop_every > 0 && j % o.loop_every == 0) {
       std::vector<int> candidates;
       for (int i = 0; i + o.min_loop_gap <= j; ++i) {
-        if ((out.T_world_origin[static_cast<size_t>(i)].translation() - cur.translation())
-                .norm() < o.loop_radius_m) {
+        if ((out.T_world_origin[static_cast<size_t>(i)].translation() - cur.translation()).norm() <
+            o.loop_radius_m) {
           candidates.push_back(i);
         }
       }
@@ -93,9 +90,8 @@ SyntheticSubmapTrajectory MakeSyntheticSubmapTrajectory(
         loop.T_a_b = MakePose(
             c_true.translation() + Eigen::Vector3d(c_sigma[0] * n01(rng), c_sigma[1] * n01(rng),
                                                    c_sigma[2] * n01(rng)),
-            c_true.linear() *
-                ExpSO3(Eigen::Vector3d(c_sigma[3] * n01(rng), c_sigma[4] * n01(rng),
-                                       c_sigma[5] * n01(rng))));
+            c_true.linear() * ExpSO3(Eigen::Vector3d(c_sigma[3] * n01(rng), c_sigma[4] * n01(rng),
+                                                     c_sigma[5] * n01(rng))));
         loop.covariance = c_sigma.cwiseAbs2().asDiagonal();
         step.loops.push_back(loop);
       }

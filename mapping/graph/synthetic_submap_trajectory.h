@@ -19,16 +19,16 @@ namespace rover::mapping {
 
 struct SyntheticSubmapTrajectoryOptions {
   int submaps = 1000;
-  double step_m = 2.0;               ///< Travel between consecutive origins.
-  double area_half_width_m = 40.0;   ///< The rover turns back at this |x| or |y|.
-  int loop_every = 5;                ///< Submaps between loop-closure attempts.
-  double loop_radius_m = 8.0;        ///< Match candidates lie within this distance.
-  int min_loop_gap = 20;             ///< Matched submaps are at least this far apart in index.
-  double w_sigma_p_m = 0.05;         ///< Frame switch translation noise (per axis).
-  double w_sigma_yaw_rad = 0.005;    ///< Frame switch yaw noise.
-  double c_sigma_p_m = 0.05;         ///< Submap match translation noise (per axis).
-  double c_sigma_rot_rad = 0.005;    ///< Submap match rotation noise (per axis).
-  int filter_poses_per_submap = 1;   ///< v factors per submap.
+  double step_m = 2.0;              ///< Travel between consecutive origins.
+  double area_half_width_m = 40.0;  ///< The rover turns back at this |x| or |y|.
+  int loop_every = 5;               ///< Submaps between loop-closure attempts.
+  double loop_radius_m = 8.0;       ///< Match candidates lie within this distance.
+  int min_loop_gap = 20;            ///< Matched submaps are at least this far apart in index.
+  double w_sigma_p_m = 0.05;        ///< Frame switch translation noise (per axis).
+  double w_sigma_yaw_rad = 0.005;   ///< Frame switch yaw noise.
+  double c_sigma_p_m = 0.05;        ///< Submap match translation noise (per axis).
+  double c_sigma_rot_rad = 0.005;   ///< Submap match rotation noise (per axis).
+  int filter_poses_per_submap = 1;  ///< v factors per submap.
 };
 
 struct SyntheticLoop {
