@@ -12,9 +12,10 @@
 //     ancestors in the elimination tree,
 //   - solves for delta, relinearises only the variables whose delta exceeds a
 //     threshold (and their factors), and repeats until none does.
-// The ordering is a nested dissection of the factor graph (shallow
-// elimination tree, so few ancestors); new variables are appended at the end
-// and the graph is re-dissected every `reorder_interval` new variables.
+// The ordering is an approximate minimum degree ordering of the variable
+// graph (Eigen's AMD); new variables are appended at the end (they are the
+// ones the next factors touch, so their columns are near the root) and the
+// graph is re-ordered every `reorder_interval` new variables.
 // Robust (Cauchy) factors contribute the exact Hessian of 1/2 rho(|r|^2),
 // J^T (rho' I + 2 rho'' r r^T) J, and the gradient rho' J^T r: the same
 // stationary points as Ceres's robustified cost, reached in a few Newton steps
