@@ -5,17 +5,19 @@
 // relinearisation, Kaess et al. 2012, on a block Cholesky factor instead of a
 // Bayes tree). Every variable keeps a linearisation point theta and a step
 // delta (estimate = theta (+) delta); every factor keeps its whitened Jacobian
-// blocks and residual at the theta of its variables. An update
+// blocks and residual at the theta of its variables (the same
+// RelativePose3dCost / PosePrior3dCost as the Ceres problem). An update
 //   - linearises the new factors,
 //   - re-factors only the block columns of L (H = L L^T, 6x6 blocks, fixed
 //     ordering) that the change reaches: the changed columns and their
 //     ancestors in the elimination tree,
 //   - solves for delta, relinearises only the variables whose delta exceeds a
 //     threshold (and their factors), and repeats until none does.
-// The ordering is an approximate minimum degree ordering of the variable
-// graph (Eigen's AMD); new variables are appended at the end (they are the
-// ones the next factors touch, so their columns are near the root) and the
-// graph is re-ordered every `reorder_interval` new variables.
+// The ordering is Eigen's approximate minimum degree on the older variables
+// with the newest ones last (as iSAM2 constrains CCOLAMD: new factors touch
+// them, and their columns near the root have few ancestors); variables added
+// later are appended, and the graph is re-ordered every `reorder_interval` of
+// them.
 // Robust (Cauchy) factors contribute the exact Hessian of 1/2 rho(|r|^2),
 // J^T (rho' I + 2 rho'' r r^T) J, and the gradient rho' J^T r: the same
 // stationary points as Ceres's robustified cost, reached in a few Newton steps
@@ -36,8 +38,8 @@ namespace rover::mapping {
 struct IncrementalPoseSolverOptions {
   /// A variable is relinearised when the rotation part of its step exceeds
   /// this [rad] in any component, or the translation part
-  /// relinearize_translation_m [m]. Both 0: every variable that moves is
-  /// relinearised every iteration (batch Gauss-Newton).
+  /// relinearize_translation_m [m]. Both 0 (with reorder_interval 0): every
+  /// variable and every column, every iteration (batch Gauss-Newton).
   double relinearize_rotation_rad = 1e-3;
   double relinearize_translation_m = 1e-3;
   /// Both variables of a robust factor are relinearised when its weight rho'
@@ -48,7 +50,7 @@ struct IncrementalPoseSolverOptions {
   double step_tolerance = 1e-6;
   int max_iterations = 10;
   /// New variables appended at the end of the ordering before the graph is
-  /// re-dissected (full re-factorisation). 0: re-order and re-factor everything
+  /// re-ordered (full re-factorisation). 0: re-order and re-factor everything
   /// at every update (batch).
   int reorder_interval = 100;
   /// Cauchy scale c of robust factors (Mahalanobis units).
