@@ -7,7 +7,7 @@
 // optionally against the Ceres full solve. Agreement: after every update, the
 // largest origin difference between the incremental and the full solution.
 //
-//   bench_graph_update [--submaps N] [--seeds K] [--loop-every N]
+//   bench_graph_update [--submaps N] [--first-seed S] [--seeds K] [--loop-every N]
 //                      [--relinearize-rotation-rad X] [--relinearize-translation-m X]
 //                      [--w-sigma-p-m X] [--w-sigma-yaw-rad X] [--ceres] [--verbose]
 
@@ -60,6 +60,7 @@ Gap OriginGap(const RoverGraph& a, const RoverGraph& b, int64_t submaps) {
 
 struct Args {
   int submaps = 1000;
+  int first_seed = 1;
   int seeds = 3;
   int loop_every = 5;
   double relinearize_rotation_rad = RoverGraphOptions{}.relinearize_rotation_rad;
@@ -83,6 +84,8 @@ Args Parse(int argc, char** argv) {
     };
     if (s == "--submaps") {
       a.submaps = std::atoi(next());
+    } else if (s == "--first-seed") {
+      a.first_seed = std::atoi(next());
     } else if (s == "--seeds") {
       a.seeds = std::atoi(next());
     } else if (s == "--loop-every") {
@@ -113,7 +116,7 @@ int Run(const Args& args) {
       "ratio p50 p99 | gap max mm deg | cov rel gap near / stale-PSD min eig%s\n",
       args.ceres ? " | ceres full ms p50 p99" : "");
   std::vector<double> ratio_p50, ratio_p99, gap_mm;
-  for (int seed = 1; seed <= args.seeds; ++seed) {
+  for (int seed = args.first_seed; seed < args.first_seed + args.seeds; ++seed) {
     SyntheticSubmapTrajectoryOptions so;
     so.submaps = args.submaps;
     so.loop_every = args.loop_every;
