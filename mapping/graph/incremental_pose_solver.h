@@ -40,8 +40,8 @@ struct IncrementalPoseSolverOptions {
   /// this [rad] in any component, or the translation part
   /// relinearize_translation_m [m]. Both 0 (with reorder_interval 0): every
   /// variable and every column, every iteration (batch Gauss-Newton).
-  double relinearize_rotation_rad = 1e-3;
-  double relinearize_translation_m = 1e-3;
+  double relinearize_rotation_rad = 5e-4;
+  double relinearize_translation_m = 5e-4;
   /// Both variables of a robust factor are relinearised when its weight rho'
   /// at the predicted residual differs from the linearised one by more than
   /// this fraction.

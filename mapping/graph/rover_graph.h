@@ -61,8 +61,8 @@ struct RoverGraphOptions {
   /// Rotation step [rad] and translation step [m] above which the
   /// incremental solver relinearises a variable (IncrementalPoseSolverOptions).
   /// Both 0: every variable every iteration (batch Gauss-Newton).
-  double relinearize_rotation_rad = 1e-3;
-  double relinearize_translation_m = 1e-3;
+  double relinearize_rotation_rad = 5e-4;
+  double relinearize_translation_m = 5e-4;
   /// New variables appended to the elimination ordering before it is
   /// recomputed (a full re-factorisation). 0: every update (batch).
   int reorder_interval = 100;
