@@ -7,8 +7,10 @@
 #include <chrono>
 #include <deque>
 #include <set>
+#include <stdexcept>
 
 #include "core/geometry/so3.h"
+#include "mapping/graph/incremental_pose_solver.h"
 #include "mapping/graph/pose_manifold.h"
 #include "mapping/graph/relative_pose_3d_cost.h"
 
@@ -68,7 +70,36 @@ RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
   o.compute_origin_covariances =
       node.Get<bool>("compute_origin_covariances", o.compute_origin_covariances);
   o.incremental = node.Get<bool>("incremental", o.incremental);
+  o.incremental_solve = node.Get<bool>("incremental_solve", o.incremental_solve);
+  o.relinearize_rotation_rad =
+      node.GetInRange<double>("relinearize_rotation_rad", 0.0, 1.0, o.relinearize_rotation_rad);
+  o.relinearize_translation_m =
+      node.GetInRange<double>("relinearize_translation_m", 0.0, 100.0, o.relinearize_translation_m);
+  o.reorder_interval = node.GetInRange<int>("reorder_interval", 0, 1000000, o.reorder_interval);
+  o.covariance_hops = node.GetInRange<int>("covariance_hops", -1, 1000000, o.covariance_hops);
+  o.Validate();
   return o;
+}
+
+void RoverGraphOptions::Validate() const {
+  const auto require = [](bool ok, const std::string& key, const std::string& expected,
+                          double found) {
+    if (!ok) {
+      throw std::invalid_argument("RoverGraphOptions." + key + ": expected " + expected +
+                                  ", found " + std::to_string(found));
+    }
+  };
+  require(cauchy_scale > 0.0, "cauchy_scale", "> 0", cauchy_scale);
+  require(frame_switch_roll_pitch_sigma_rad > 0.0, "frame_switch_roll_pitch_sigma_rad", "> 0",
+          frame_switch_roll_pitch_sigma_rad);
+  require(max_iterations >= 1, "max_iterations", ">= 1", max_iterations);
+  require(num_threads >= 1, "num_threads", ">= 1", num_threads);
+  require(relinearize_rotation_rad >= 0.0 && relinearize_rotation_rad <= 1.0,
+          "relinearize_rotation_rad", "in [0, 1]", relinearize_rotation_rad);
+  require(relinearize_translation_m >= 0.0 && relinearize_translation_m <= 100.0,
+          "relinearize_translation_m", "in [0, 100]", relinearize_translation_m);
+  require(reorder_interval >= 0, "reorder_interval", ">= 0", reorder_interval);
+  require(covariance_hops >= -1, "covariance_hops", ">= -1", covariance_hops);
 }
 
 struct RoverGraph::Variable {
@@ -85,6 +116,7 @@ struct RoverGraph::Factor {
   Matrix6d covariance = Matrix6d::Identity();  // As given: for covariance propagation.
   bool robust = false;
   bool in_problem = false;
+  bool in_solver = false;
 };
 
 class RoverGraph::Impl {
@@ -95,6 +127,16 @@ class RoverGraph::Impl {
     po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     problem_ = std::make_unique<ceres::Problem>(po);
+    options_.Validate();
+    if (options_.incremental && options_.incremental_solve) {
+      IncrementalPoseSolverOptions io;
+      io.relinearize_rotation_rad = options_.relinearize_rotation_rad;
+      io.relinearize_translation_m = options_.relinearize_translation_m;
+      io.reorder_interval = options_.reorder_interval;
+      io.max_iterations = std::min(options_.max_iterations, 20);
+      io.cauchy_scale = options_.cauchy_scale;
+      solver_ = std::make_unique<IncrementalPoseSolver>(io);
+    }
   }
 
   void Add(Factor f, const Matrix6d& covariance, const std::string& what) {
@@ -208,7 +250,7 @@ class RoverGraph::Impl {
       for (const Factor* f : pending) {
         if (!f->b) {
           if (f->a.type == GraphKey::Type::kOrigin && origin_covariance_.count(f->a) == 0) {
-            origin_covariance_[f->a] = f->covariance;
+            SetOriginCovariance(f->a, f->covariance);
             progress = true;
           }
           continue;
@@ -223,8 +265,8 @@ class RoverGraph::Impl {
         J_a.bottomRightCorner<3, 3>() = f->Z.linear().transpose();
         Matrix6d J_z = Matrix6d::Identity();
         J_z.topLeftCorner<3, 3>() = R_a;
-        origin_covariance_[b] =
-            J_a * a_cov->second * J_a.transpose() + J_z * f->covariance * J_z.transpose();
+        SetOriginCovariance(b, J_a * CurrentOriginCovariance(f->a) * J_a.transpose() +
+                                   J_z * f->covariance * J_z.transpose());
         progress = true;
       }
     }
@@ -266,6 +308,7 @@ class RoverGraph::Impl {
       const bool covariances_known =
           !options_.compute_origin_covariances || PropagateCovariancesToNewOrigins();
       AddPendingToProblem();
+      AddPendingToSolver();
       out.variables = static_cast<int>(variables_.size());
       out.factors = static_cast<int>(factors_.size());
       out.converged = true;
@@ -275,7 +318,82 @@ class RoverGraph::Impl {
         return out;
       }
     }
+    if (solver_ && solved_once_) return SolveIncrementally(out);
     return Solve(out);
+  }
+
+  // Mirrors the variables and factors of the Ceres problem into the
+  // incremental solver; returns the solver indices of the new factors'
+  // variables (where the marginals change most).
+  std::vector<int> AddPendingToSolver() {
+    std::vector<int> touched;
+    if (!solver_) return touched;
+    for (auto& [key, v] : variables_) {
+      if (!v.in_problem || solver_index_.count(key) != 0) continue;
+      solver_index_[key] = solver_->AddVariable(v.x.data());
+      solver_keys_.push_back(key);
+    }
+    for (Factor& f : factors_) {
+      if (!f.in_problem || f.in_solver) continue;
+      const int a = solver_index_.at(f.a);
+      const int b = f.b ? solver_index_.at(*f.b) : -1;
+      solver_->AddFactor(a, b, f.Z, f.information, f.robust);
+      f.in_solver = true;
+      touched.push_back(a);
+      if (b >= 0) touched.push_back(b);
+    }
+    return touched;
+  }
+
+  // Loop-closing update without a full solve: the incremental Gauss-Newton
+  // touches the changed part of the factor; the origin marginals near the new
+  // factors are recomputed, the others kept (see RoverGraphOptions).
+  RoverGraphSummary SolveIncrementally(RoverGraphSummary out) {
+    AddPendingToProblem();
+    const std::vector<int> seeds = AddPendingToSolver();
+    const Clock::time_point start = Clock::now();
+    IncrementalPoseSolverStats stats;
+    try {
+      stats = solver_->Update();
+    } catch (const std::runtime_error&) {
+      return Solve(out);  // singular system: let Ceres (with its damping) decide
+    }
+    if (!stats.converged) return Solve(out);
+    for (size_t i = 0; i < solver_keys_.size(); ++i) {
+      solver_->Estimate(static_cast<int>(i), variables_.at(solver_keys_[i]).x.data());
+    }
+    out.solve_time_s = Seconds(start);
+    out.iterations = stats.iterations;
+    out.initial_cost = last_cost_;
+    out.final_cost = last_cost_ = solver_->LinearizedCost();
+    out.converged = true;
+    out.solved = true;
+    out.incremental_solve = true;
+    out.relinearized = stats.relinearized_variables;
+    out.refactored_columns = stats.refactored_columns;
+    out.variables = static_cast<int>(variables_.size());
+    out.factors = static_cast<int>(factors_.size());
+    if (options_.compute_origin_covariances) {
+      const Clock::time_point cov_start = Clock::now();
+      std::vector<int> targets;
+      if (options_.covariance_hops < 0) {
+        for (size_t i = 0; i < solver_keys_.size(); ++i) targets.push_back(static_cast<int>(i));
+      } else {
+        targets = solver_->Neighbourhood(seeds, options_.covariance_hops);
+        for (size_t i = 0; i < solver_keys_.size(); ++i) {
+          if (origin_covariance_.count(solver_keys_[i]) == 0)
+            targets.push_back(static_cast<int>(i));
+        }
+      }
+      for (const int i : targets) {
+        const GraphKey& key = solver_keys_[static_cast<size_t>(i)];
+        if (key.type != GraphKey::Type::kOrigin) continue;
+        SetOriginCovariance(key, solver_->MarginalCovariance(i));
+        ++out.covariances_updated;
+      }
+      out.covariance_time_s = Seconds(cov_start);
+    }
+    return out;
   }
 
   RoverGraphSummary Solve(RoverGraphSummary out) {
@@ -310,7 +428,31 @@ class RoverGraph::Impl {
       ComputeOriginCovariances();
       out.covariance_time_s = Seconds(cov_start);
     }
+    if (solver_) {
+      // The incremental solver continues from this optimum.
+      AddPendingToSolver();
+      std::vector<const double*> x_of;
+      for (const GraphKey& key : solver_keys_) x_of.push_back(variables_.at(key).x.data());
+      solver_->ResetLinearization(x_of);
+    }
     return out;
+  }
+
+  // Stores a marginal with the origin's current rotation: the translation
+  // block is over world axes, so a marginal kept while later solves rotate
+  // the origin is re-expressed with the rotation change (OriginCovariance).
+  void SetOriginCovariance(const GraphKey& key, const Matrix6d& covariance) {
+    origin_covariance_[key] = covariance;
+    covariance_rotation_[key] = PoseFromParameters(variables_.at(key).x.data()).linear();
+  }
+
+  Matrix6d CurrentOriginCovariance(const GraphKey& key) const {
+    const auto it = origin_covariance_.find(key);
+    if (it == origin_covariance_.end()) throw GraphError("no covariance for " + key.ToString());
+    Matrix6d G = Matrix6d::Identity();
+    G.topLeftCorner<3, 3>() = PoseFromParameters(variables_.at(key).x.data()).linear() *
+                              covariance_rotation_.at(key).transpose();
+    return G * it->second * G.transpose();
   }
 
   void ComputeOriginCovariances() {
@@ -331,16 +473,20 @@ class RoverGraph::Impl {
       if (key.type != GraphKey::Type::kOrigin || !v.in_problem) continue;
       Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
       covariance.GetCovarianceBlockInTangentSpace(v.x.data(), v.x.data(), C.data());
-      origin_covariance_[key] = C;
+      SetOriginCovariance(key, C);
     }
   }
 
   const RoverGraphOptions options_;
+  std::unique_ptr<IncrementalPoseSolver> solver_;
+  std::map<GraphKey, int> solver_index_;
+  std::vector<GraphKey> solver_keys_;  // by solver index
   PoseManifold manifold_;
   ceres::CauchyLoss cauchy_;
   std::map<GraphKey, Variable> variables_;
   std::vector<Factor> factors_;
   std::map<GraphKey, Matrix6d> origin_covariance_;
+  std::map<GraphKey, Eigen::Matrix3d> covariance_rotation_;  // R_world_origin when computed
   std::vector<GraphKey> unanchored_;
   bool solved_once_ = false;
   double last_cost_ = 0.0;
@@ -448,11 +594,7 @@ Eigen::Isometry3d RoverGraph::Estimate(const GraphKey& key) const {
 
 Matrix6d RoverGraph::OriginCovariance(int robot, int64_t submap) const {
   const GraphKey key = GraphKey::Origin(robot, submap);
-  const auto it = impl_->origin_covariance_.find(key);
-  if (it == impl_->origin_covariance_.end()) {
-    throw GraphError("no covariance for " + key.ToString());
-  }
-  return it->second;
+  return impl_->CurrentOriginCovariance(key);
 }
 
 Eigen::Isometry3d RoverGraph::GlobalPose(int robot) const {

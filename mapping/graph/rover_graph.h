@@ -53,9 +53,32 @@ struct RoverGraphOptions {
   /// graph (odometry extending a chain, a new filter pose): composing them is
   /// then the exact optimum, and new origin marginals are propagated.
   bool incremental = true;
+  /// With `incremental`: updates that close loops run the incremental
+  /// Gauss-Newton (IncrementalPoseSolver: fluid relinearisation, partial
+  /// re-factorisation) instead of a full Ceres solve; the first solve and a
+  /// non-converged update fall back to Ceres.
+  bool incremental_solve = true;
+  /// Rotation step [rad] and translation step [m] above which the
+  /// incremental solver relinearises a variable (IncrementalPoseSolverOptions).
+  /// Both 0: every variable every iteration (batch Gauss-Newton).
+  double relinearize_rotation_rad = 5e-4;
+  double relinearize_translation_m = 5e-4;
+  /// New variables appended to the elimination ordering before it is
+  /// recomputed (a full re-factorisation). 0: every update (batch).
+  int reorder_interval = 100;
+  /// After an incremental solve, the origin marginals within this many factor
+  /// hops of the new factors' variables are recomputed; the others keep their
+  /// last value (an upper bound to first order: factors only add
+  /// information). -1: all origins.
+  int covariance_hops = 2;
+
+  /// Throws std::invalid_argument naming the first out-of-range key.
+  void Validate() const;
 
   /// Keys: cauchy_scale, frame_switch_roll_pitch_sigma_rad, max_iterations,
-  /// num_threads, compute_origin_covariances, incremental (all optional).
+  /// num_threads, compute_origin_covariances, incremental, incremental_solve,
+  /// relinearize_rotation_rad, relinearize_translation_m, reorder_interval,
+  /// covariance_hops (all optional).
   static RoverGraphOptions Load(const ConfigNode& node);
 };
 
@@ -87,6 +110,13 @@ struct RoverGraphSummary {
   bool converged = false;
   /// False when the update only extended the graph (no solve was needed).
   bool solved = false;
+  /// True when the solve was the incremental one (options.incremental_solve).
+  bool incremental_solve = false;
+  /// Incremental solve: variables relinearised and block columns of the
+  /// factor recomputed (of `variables`), origin marginals recomputed.
+  int relinearized = 0;
+  int refactored_columns = 0;
+  int covariances_updated = 0;
   /// Variables no prior reaches (e.g. a robot not yet linked to the team, or
   /// a chain broken by a refused factor): left out of the solve, with their
   /// factors, until a factor connects them.

@@ -1,0 +1,214 @@
+// Online pose-graph updates (RoverGraph, as mapd's SlamWorker runs them) on a
+// synthetic 1000-submap rover sequence with loop closures: per-update time of
+// the incremental solver (fluid relinearisation, partial re-factorisation,
+// origin marginals near the change) against a full re-solve of the whole
+// graph with the same solver in the same run (every variable relinearised,
+// re-ordered and re-factored at every update, all origin marginals), and
+// optionally against the Ceres full solve. Agreement: after every update, the
+// largest origin difference between the incremental and the full solution.
+//
+//   bench_graph_update [--submaps N] [--first-seed S] [--seeds K] [--loop-every N]
+//                      [--relinearize-rotation-rad X] [--relinearize-translation-m X]
+//                      [--w-sigma-p-m X] [--w-sigma-yaw-rad X] [--ceres] [--verbose]
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "core/geometry/so3.h"
+#include "mapping/graph/rover_graph.h"
+#include "mapping/graph/synthetic_submap_trajectory.h"
+
+namespace rover::mapping {
+namespace {
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto k = static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(k, v.size() - 1)];
+}
+
+double TimedOptimize(RoverGraph* graph, RoverGraphSummary* summary) {
+  const auto start = std::chrono::steady_clock::now();
+  *summary = graph->Optimize();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+struct Gap {
+  double translation_m = 0.0;
+  double rotation_rad = 0.0;
+};
+
+Gap OriginGap(const RoverGraph& a, const RoverGraph& b, int64_t submaps) {
+  Gap gap;
+  for (int64_t k = 0; k < submaps; ++k) {
+    const Eigen::Isometry3d A = a.Origin(0, k);
+    const Eigen::Isometry3d B = b.Origin(0, k);
+    gap.translation_m = std::max(gap.translation_m, (A.translation() - B.translation()).norm());
+    gap.rotation_rad =
+        std::max(gap.rotation_rad, LogSO3(A.linear().transpose() * B.linear()).norm());
+  }
+  return gap;
+}
+
+struct Args {
+  int submaps = 1000;
+  int first_seed = 1;
+  int seeds = 3;
+  int loop_every = 5;
+  double relinearize_rotation_rad = RoverGraphOptions{}.relinearize_rotation_rad;
+  double relinearize_translation_m = RoverGraphOptions{}.relinearize_translation_m;
+  bool ceres = false;
+  bool verbose = false;
+  double w_sigma_p_m = SyntheticSubmapTrajectoryOptions{}.w_sigma_p_m;
+  double w_sigma_yaw_rad = SyntheticSubmapTrajectoryOptions{}.w_sigma_yaw_rad;
+};
+
+Args Parse(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string s = argv[i];
+    const auto next = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s: expected a value\n", s.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (s == "--submaps") {
+      a.submaps = std::atoi(next());
+    } else if (s == "--first-seed") {
+      a.first_seed = std::atoi(next());
+    } else if (s == "--seeds") {
+      a.seeds = std::atoi(next());
+    } else if (s == "--loop-every") {
+      a.loop_every = std::atoi(next());
+    } else if (s == "--relinearize-rotation-rad") {
+      a.relinearize_rotation_rad = std::atof(next());
+    } else if (s == "--relinearize-translation-m") {
+      a.relinearize_translation_m = std::atof(next());
+    } else if (s == "--w-sigma-p-m") {
+      a.w_sigma_p_m = std::atof(next());
+    } else if (s == "--w-sigma-yaw-rad") {
+      a.w_sigma_yaw_rad = std::atof(next());
+    } else if (s == "--verbose") {
+      a.verbose = true;
+    } else if (s == "--ceres") {
+      a.ceres = true;
+    } else {
+      std::fprintf(stderr, "unknown argument %s\n", s.c_str());
+      std::exit(2);
+    }
+  }
+  return a;
+}
+
+int Run(const Args& args) {
+  std::printf(
+      "seed loops | incremental ms p50 p99 max (cov p99) | full same solver ms p50 p99 max | "
+      "ratio p50 p99 | gap max mm deg | cov rel gap near / stale-PSD min eig%s\n",
+      args.ceres ? " | ceres full ms p50 p99" : "");
+  std::vector<double> ratio_p50, ratio_p99, gap_mm;
+  for (int seed = args.first_seed; seed < args.first_seed + args.seeds; ++seed) {
+    SyntheticSubmapTrajectoryOptions so;
+    so.submaps = args.submaps;
+    so.loop_every = args.loop_every;
+    so.w_sigma_p_m = args.w_sigma_p_m;
+    so.w_sigma_yaw_rad = args.w_sigma_yaw_rad;
+    const SyntheticSubmapTrajectory traj =
+        MakeSyntheticSubmapTrajectory(so, static_cast<uint32_t>(seed));
+    RoverGraphOptions inc_options;
+    inc_options.relinearize_rotation_rad = args.relinearize_rotation_rad;
+    inc_options.relinearize_translation_m = args.relinearize_translation_m;
+    RoverGraphOptions full_options = inc_options;  // the same solver as a batch
+    full_options.relinearize_rotation_rad = 0.0;
+    full_options.relinearize_translation_m = 0.0;
+    full_options.reorder_interval = 0;
+    full_options.covariance_hops = -1;
+    RoverGraphOptions ceres_options;
+    ceres_options.incremental_solve = false;
+    RoverGraph inc(inc_options), full(full_options), ceres(ceres_options);
+    std::vector<RoverGraph*> graphs = {&inc, &full};
+    if (args.ceres) graphs.push_back(&ceres);
+    for (RoverGraph* g : graphs) {
+      traj.AddPrior(g);
+      g->Optimize();
+    }
+    std::vector<double> t_inc, t_full, t_ceres, t_cov;
+    Gap worst;
+    for (size_t i = 0; i < traj.steps.size(); ++i) {
+      int loops = 0;
+      for (RoverGraph* g : graphs) loops = traj.AddStep(i, g);
+      RoverGraphSummary s_inc, s_full, s_ceres;
+      const double ti = TimedOptimize(&inc, &s_inc);
+      const double tf = TimedOptimize(&full, &s_full);
+      if (loops == 0) continue;  // extensions: no solve on either side
+      t_inc.push_back(ti);
+      t_full.push_back(tf);
+      t_cov.push_back(1e3 * s_inc.covariance_time_s);
+      if (args.verbose) {
+        std::printf(
+            "  submap %4lld: incremental %7.2f ms (%s, %d it, %d relinearised, %d columns of %d, "
+            "%d marginals) full %7.2f ms\n",
+            static_cast<long long>(traj.steps[i].submap), ti,
+            s_inc.incremental_solve ? "incremental" : "CERES fallback", s_inc.iterations,
+            s_inc.relinearized, s_inc.refactored_columns, s_inc.variables,
+            s_inc.covariances_updated, tf);
+      }
+      if (args.ceres) t_ceres.push_back(TimedOptimize(&ceres, &s_ceres));
+      const Gap gap = OriginGap(inc, full, traj.steps[i].submap + 1);
+      worst.translation_m = std::max(worst.translation_m, gap.translation_m);
+      worst.rotation_rad = std::max(worst.rotation_rad, gap.rotation_rad);
+    }
+    // Marginals at the end: recomputed ones (near the last change) against
+    // the full solver's exact ones, and how far below the exact ones any
+    // stale marginal is (negative = not an upper bound).
+    double near_gap = 0.0, stale_min_eig = 1e9;
+    const int64_t last = traj.steps.back().submap;
+    for (int64_t k = 0; k <= last; ++k) {
+      const Matrix6d a = inc.OriginCovariance(0, k);
+      const Matrix6d b = full.OriginCovariance(0, k);
+      const double rel = (a - b).norm() / b.norm();
+      if (k >= last - 2) near_gap = std::max(near_gap, rel);
+      const Eigen::SelfAdjointEigenSolver<Matrix6d> es(0.5 * (a - b + (a - b).transpose()));
+      stale_min_eig = std::min(stale_min_eig, es.eigenvalues()(0) / b.norm());
+    }
+    const double r50 = Percentile(t_full, 0.5) / Percentile(t_inc, 0.5);
+    const double r99 = Percentile(t_full, 0.99) / Percentile(t_inc, 0.99);
+    ratio_p50.push_back(r50);
+    ratio_p99.push_back(r99);
+    gap_mm.push_back(1e3 * worst.translation_m);
+    std::printf(
+        "%4d %5zu | %6.2f %6.2f %6.2f (%5.2f) | %7.2f %7.2f %7.2f | %5.1f %5.1f | %6.3f %6.4f | "
+        "%.1e / %.1e",
+        seed, t_inc.size(), Percentile(t_inc, 0.5), Percentile(t_inc, 0.99), Percentile(t_inc, 1.0),
+        Percentile(t_cov, 0.99), Percentile(t_full, 0.5), Percentile(t_full, 0.99),
+        Percentile(t_full, 1.0), r50, r99, 1e3 * worst.translation_m,
+        worst.rotation_rad * 180.0 / 3.14159265358979, near_gap, stale_min_eig);
+    if (args.ceres) {
+      std::printf(" | %7.1f %7.1f", Percentile(t_ceres, 0.5), Percentile(t_ceres, 0.99));
+    }
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+  std::printf("spread over seeds: ratio p50 %.1f-%.1f, ratio p99 %.1f-%.1f, gap %.3f-%.3f mm\n",
+              *std::min_element(ratio_p50.begin(), ratio_p50.end()),
+              *std::max_element(ratio_p50.begin(), ratio_p50.end()),
+              *std::min_element(ratio_p99.begin(), ratio_p99.end()),
+              *std::max_element(ratio_p99.begin(), ratio_p99.end()),
+              *std::min_element(gap_mm.begin(), gap_mm.end()),
+              *std::max_element(gap_mm.begin(), gap_mm.end()));
+  return 0;
+}
+
+}  // namespace
+}  // namespace rover::mapping
+
+int main(int argc, char** argv) { return rover::mapping::Run(rover::mapping::Parse(argc, argv)); }
