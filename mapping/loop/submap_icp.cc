@@ -17,6 +17,9 @@ using loop_internal::CheckPositive;
 using loop_internal::CheckRange;
 
 constexpr double kDistanceShrink = 0.7;
+// The Cauchy scale starts at this share of the initial correspondence
+// distance: residuals across the whole basin still pull.
+constexpr double kRobustStartFactor = 0.5;
 
 // Cauchy weight of a squared residual; 1 without a scale.
 double Weight(double r_sq, double scale_m) {
@@ -72,20 +75,26 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
   Mat H = Mat::Zero();
   Vec g = Vec::Zero();
   double sum_sq = 0.0;
+  double plain_sum_sq = 0.0;
   double point_sum_sq = 0.0;
   int residuals = 0;
   int matched = 0;
   int considered = 0;
+  // The Cauchy scale anneals with the correspondence distance (see
+  // robust_scale_m).
+  double robust_c = kRobustStartFactor * o.initial_distance_m;
   for (int it = 0; it < o.max_iterations; ++it) {
     result.iterations = it + 1;
     H.setZero();
     g.setZero();
     sum_sq = 0.0;
+    plain_sum_sq = 0.0;
     point_sum_sq = 0.0;
     residuals = 0;
     matched = 0;
     considered = 0;
     const Eigen::Isometry3d T = result.T_a_b;
+    const double c = o.robust_scale_m > 0.0 ? std::max(o.robust_scale_m, robust_c) : 0.0;
     const auto reach = static_cast<float>(max_distance);
     for (std::size_t j = 0; j < source.size(); ++j) {
       const Eigen::Vector3d q = T * source[j].cast<double>();
@@ -105,17 +114,19 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
         const Eigen::Vector3d normal = target_normals[n.index].cast<double>();
         const double r = normal.dot(q - p);
         const Eigen::Matrix<double, 1, Dof> J = normal.transpose() * Jq;
-        const double w = Weight(r * r, o.robust_scale_m);
+        const double w = Weight(r * r, c);
         H.noalias() += w * J.transpose() * J;
         g.noalias() += w * J.transpose() * r;
         sum_sq += w * r * r;
+        plain_sum_sq += r * r;
         ++residuals;
       } else {
         const Eigen::Vector3d r = q - p;
-        const double w = Weight(r.squaredNorm(), o.robust_scale_m);
+        const double w = Weight(r.squaredNorm(), c);
         H.noalias() += w * Jq.transpose() * Jq;
         g.noalias() += w * Jq.transpose() * r;
         sum_sq += w * r.squaredNorm();
+        plain_sum_sq += r.squaredNorm();
         residuals += 3;
       }
     }
@@ -129,13 +140,14 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
     }
     const Vec delta = -ldlt.solve(g);
     ApplyLeft<Dof>(delta, &result.T_a_b);
-    const bool at_final = max_distance <= o.final_distance_m;
+    const bool at_final = max_distance <= o.final_distance_m && c <= o.robust_scale_m;
     if (at_final && delta.template head<3>().norm() < o.convergence_m &&
         delta.template tail<Dof - 3>().norm() < o.convergence_rad) {
       result.converged = true;
       break;
     }
     max_distance = std::max(o.final_distance_m, max_distance * kDistanceShrink);
+    robust_c *= kDistanceShrink;
   }
 
   result.ok = true;
@@ -152,7 +164,8 @@ SubmapIcpResult Align(const SubmapMatchData& a, const SubmapMatchData& b,
   result.correspondences = matched;
   result.overlap_points = matched;
   result.source_points = considered;
-  result.rmse_m = std::sqrt(sum_sq / matched);
+  // Unweighted: the Cauchy weights would hide a poor fit from the RMSE test.
+  result.rmse_m = std::sqrt(plain_sum_sq / matched);
   result.point_rmse_m = std::sqrt(point_sum_sq / std::max(1, matched));
   // s^2 H^-1 over the left perturbation, then to [dp (a); dtheta (right)]:
   // t_true = Exp(dphi) t + dt  =>  dp = dt - [t]x dphi;  dtheta = R^T dphi.

@@ -39,8 +39,12 @@ struct SubmapIcpOptions {
   double convergence_m = 1e-3;
   double convergence_rad = 1e-4;
   /// Cauchy weights w = 1 / (1 + (r / c)^2) on the residuals (iteratively
-  /// reweighted), c = robust_scale_m; 0: plain least squares within the
-  /// correspondence distance.
+  /// reweighted). c anneals like the correspondence distance, from half the
+  /// initial distance down to robust_scale_m: a small c from the start would
+  /// narrow the basin the RANSAC hypothesis has to land in; at the end it
+  /// stops the residuals of surfaces only one submap saw well (other sides
+  /// of rocks, stereo fringes) from pulling the result off by a decimetre.
+  /// 0: plain least squares within the correspondence distance.
   double robust_scale_m = 0.0;
   /// Fewer correspondences than this: the ICP fails.
   int min_correspondences = 100;

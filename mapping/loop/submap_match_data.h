@@ -14,9 +14,9 @@
 //   the cloud  with normals and its k-d tree (ICP target), and a coarser
 //              subsample (ICP source);
 //   the xy bounding box of the obstacle points (pairing, eq. 6.1);
-//   suitability: at least 1000 points and 100 obstacle points, and the
-//              keypoints spread beyond a line (>= 10 of them farther than
-//              0.5 m in xy from the best-fitting line), else the submap is
+//   suitability: at least 1000 points and 20 obstacle points, and
+//              optionally the keypoints spread beyond a line (off by
+//              default, see min_keypoints_off_line), else the submap is
 //              never paired.
 //
 // Normals point to the observed side: PCA leaves their sign open, and
@@ -62,9 +62,14 @@ struct SubmapMatchDataOptions {
   bool orient_normals_to_free_space = true;
   /// Suitability (thesis section 6.1.1).
   int min_points = 1000;
-  int min_obstacle_points = 100;
+  int min_obstacle_points = 20;
   double off_line_distance_m = 0.5;
-  int min_keypoints_off_line = 10;
+  /// 0 by default: keypoints along a line no longer make a submap
+  /// unsuitable, as the matcher takes such matches on when the ICP over the
+  /// whole cloud is well conditioned (SubmapMatcherOptions::
+  /// line_hypotheses_need_icp); on a drive through sparse rocks most submaps
+  /// see a few rocks in a row.
+  int min_keypoints_off_line = 0;
   /// Random line samples of the spread check (all pairs when fewer).
   int line_samples = 2000;
   /// Voxel grid of the ICP source subsample.

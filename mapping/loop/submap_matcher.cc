@@ -303,9 +303,12 @@ Matrix6d MatchCovariance(const SubmapIcpResult& icp, const SubmapMatcherOptions&
     cov(4, 4) = rp2;
   }
   const double sigma_m = std::max(o.min_sigma_m, o.rmse_sigma_factor * icp.rmse_m);
-  const double floors[6] = {sigma_m,  sigma_m,
-                            sigma_m,  o.roll_pitch_sigma_rad,
-                            o.roll_pitch_sigma_rad, o.min_sigma_yaw_rad};
+  const double floors[6] = {sigma_m,
+                            sigma_m,
+                            sigma_m,
+                            o.roll_pitch_sigma_rad,
+                            o.roll_pitch_sigma_rad,
+                            o.min_sigma_yaw_rad};
   for (int i = 0; i < 6; ++i) {
     const double f2 = floors[i] * floors[i];
     if (cov(i, i) < f2) cov(i, i) = f2;
@@ -341,10 +344,13 @@ void SubmapMatcherOptions::Validate() const {
   CheckRange(kC, "max_hypothesis_tilt_rad", max_hypothesis_tilt_rad, 0.0, M_PI);
   CheckPositive(kC, "hypothesis_off_line_distance_m", hypothesis_off_line_distance_m);
   CheckRange(kC, "min_inliers_off_line", min_inliers_off_line, 0, 1e6);
+  CheckPositive(kC, "max_line_icp_sigma_m", max_line_icp_sigma_m);
+  CheckPositive(kC, "max_line_icp_sigma_yaw_rad", max_line_icp_sigma_yaw_rad);
   CheckPositive(kC, "prior_sigma_factor", prior_sigma_factor);
   CheckRange(kC, "min_bound_m", min_bound_m, 0.0, 1e6);
   CheckRange(kC, "min_bound_yaw_rad", min_bound_yaw_rad, 0.0, M_PI);
   icp.Validate();
+  CheckRange(kC, "icp_passes", icp_passes, 1, 10);
   CheckRange(kC, "min_inliers", min_inliers, 2, 1e6);
   CheckRange(kC, "min_inlier_ratio", min_inlier_ratio, 0.0, 1.0);
   CheckPositive(kC, "max_icp_rmse_m", max_icp_rmse_m);
@@ -379,6 +385,10 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
   d("max_hypothesis_tilt_rad", &o.max_hypothesis_tilt_rad);
   d("hypothesis_off_line_distance_m", &o.hypothesis_off_line_distance_m);
   i("min_inliers_off_line", &o.min_inliers_off_line);
+  o.line_hypotheses_need_icp =
+      node.Get<bool>("line_hypotheses_need_icp", o.line_hypotheses_need_icp);
+  d("max_line_icp_sigma_m", &o.max_line_icp_sigma_m);
+  d("max_line_icp_sigma_yaw_rad", &o.max_line_icp_sigma_yaw_rad);
   d("prior_sigma_factor", &o.prior_sigma_factor);
   d("min_bound_m", &o.min_bound_m);
   d("min_bound_yaw_rad", &o.min_bound_yaw_rad);
@@ -399,6 +409,7 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
     o.icp.obstacle_agreement_distance_m =
         icp.Get<double>("obstacle_agreement_distance_m", o.icp.obstacle_agreement_distance_m);
   }
+  i("icp_passes", &o.icp_passes);
   i("min_inliers", &o.min_inliers);
   d("min_inlier_ratio", &o.min_inlier_ratio);
   d("max_icp_rmse_m", &o.max_icp_rmse_m);
@@ -467,7 +478,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   const PriorBounds bounds(prior, o);
   std::mt19937_64 rng(o.seed);
   Hypothesis best;
-  int on_a_line = 0;
+  Hypothesis best_on_a_line;
   for (const std::vector<std::size_t>& cluster : clusters) {
     Hypothesis h = RansacCluster(cluster, r.correspondences, a, b, bounds, o, &rng, &r.hypotheses);
     if (h.inliers <= best.inliers) continue;
@@ -476,14 +487,22 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
                      o.hypothesis_off_line_distance_m, 500, seed) < o.min_inliers_off_line ||
         CountOffLine(InlierKeypoints(h, r.correspondences, b, false),
                      o.hypothesis_off_line_distance_m, 500, seed) < o.min_inliers_off_line) {
-      ++on_a_line;
+      if (h.inliers > best_on_a_line.inliers) best_on_a_line = std::move(h);
       continue;
     }
     best = std::move(h);
   }
   r.timings.ransac_ms = MsSince(ts);
+  if (best.inliers == 0 && best_on_a_line.inliers > 0) {
+    // Without bounds nothing stops the ICP sliding along the line: its
+    // s^2 H^-1 does not show that freedom (a wall on flat ground: 2 mm).
+    if (!o.line_hypotheses_need_icp || !prior.bounded) {
+      return finish("inlier keypoints of every hypothesis along a line");
+    }
+    best = std::move(best_on_a_line);
+    r.inliers_on_a_line = true;
+  }
   if (best.inliers == 0) {
-    if (on_a_line > 0) return finish("inlier keypoints of every hypothesis along a line");
     return finish(r.hypotheses == 0 ? "no RANSAC hypothesis within the prior's bounds"
                                     : "no RANSAC hypothesis with inliers");
   }
@@ -500,6 +519,14 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   // 4. ICP.
   ts = Clock::now();
   r.icp = AlignSubmaps(a, b, best.T_a_b, o.mode == MatchMode::kFourDof, o.icp);
+  // Restarting from its own result (the correspondence distance and the
+  // Cauchy scale anneal again) lets the ICP leave a shallow minimum that
+  // the coarse RANSAC start led it into.
+  for (int pass = 1; pass < o.icp_passes && r.icp.ok; ++pass) {
+    SubmapIcpResult again = AlignSubmaps(a, b, r.icp.T_a_b, o.mode == MatchMode::kFourDof, o.icp);
+    if (!again.ok) break;
+    r.icp = again;
+  }
   r.timings.icp_ms = MsSince(ts);
   r.T_a_b = r.icp.T_a_b;
   if (!r.icp.ok) {
@@ -536,6 +563,20 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   if (r.obstacle_agreement < o.min_obstacle_agreement) {
     return finish("obstacle agreement " +
                   Describe(r.obstacle_agreement, "<", o.min_obstacle_agreement));
+  }
+  if (r.inliers_on_a_line) {
+    // The keypoints leave the match free along their line (or in yaw about
+    // it): the whole cloud, ground relief included, has to fix it.
+    const double sigma_m = std::sqrt(std::max(r.icp.covariance(0, 0), r.icp.covariance(1, 1)));
+    const double sigma_yaw = std::sqrt(r.icp.covariance(5, 5));
+    if (sigma_m > o.max_line_icp_sigma_m) {
+      return finish("inlier keypoints along a line and the ICP's xy sigma " +
+                    Describe(sigma_m, ">", o.max_line_icp_sigma_m) + " m");
+    }
+    if (sigma_yaw > o.max_line_icp_sigma_yaw_rad) {
+      return finish("inlier keypoints along a line and the ICP's yaw sigma " +
+                    Describe(sigma_yaw, ">", o.max_line_icp_sigma_yaw_rad) + " rad");
+    }
   }
   const std::string outside = bounds.Violation(r.T_a_b);
   if (!outside.empty()) return finish("final transform outside the prior's bounds: " + outside);

@@ -88,13 +88,25 @@ struct SubmapMatcherOptions {
   /// than this from the best line.
   double hypothesis_off_line_distance_m = 0.5;
   int min_inliers_off_line = 3;
+  /// When every hypothesis's inliers lie along a line: true takes the best
+  /// of them on to the ICP and accepts only if the ICP's s^2 H^-1 (before
+  /// the floors) is well conditioned, x and y sigma (frame a) at most
+  /// max_line_icp_sigma_m and yaw at most max_line_icp_sigma_yaw_rad: ground
+  /// relief and the other structure of the whole cloud can fix what a row of
+  /// keypoints leaves free. Only with a bounded prior: s^2 H^-1 does not
+  /// show the freedom along a wall on flat ground, the prior's bounds stop
+  /// the slide. false rejects such a pair.
+  bool line_hypotheses_need_icp = true;
+  double max_line_icp_sigma_m = 0.005;
+  double max_line_icp_sigma_yaw_rad = 0.08 * M_PI / 180.0;
   /// Prior bounds: |x - x_prior| <= max(k sigma_x, min_bound_m) in frame a,
   /// likewise y, z, and yaw with min_bound_yaw_rad.
   double prior_sigma_factor = 3.0;
   double min_bound_m = 0.3;
   double min_bound_yaw_rad = 3.0 * M_PI / 180.0;
-  /// Refinement.
+  /// Refinement, run icp_passes times, each from the previous result.
   SubmapIcpOptions icp;
+  int icp_passes = 2;
   /// Validity.
   int min_inliers = 6;
   double min_inlier_ratio = 0.05;
@@ -163,7 +175,10 @@ struct SubmapMatchResult {
   std::vector<KeypointMatch> correspondences;
   std::vector<KeypointMatch> inliers;
   int clusters = 0;
-  int hypotheses = 0;         ///< RANSAC hypotheses inside the prior's bounds
+  int hypotheses = 0;  ///< RANSAC hypotheses inside the prior's bounds
+  /// The winner's inlier keypoints lie along a line (then the ICP's
+  /// conditioning decided).
+  bool inliers_on_a_line = false;
   double inlier_ratio = 0.0;  ///< inliers / correspondences of the winning cluster
   /// The RANSAC winner before refinement.
   Eigen::Isometry3d T_a_b_initial = Eigen::Isometry3d::Identity();

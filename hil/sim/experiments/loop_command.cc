@@ -22,6 +22,7 @@
 #include "hil/sim/render/stereo_renderer.h"
 #include "hil/sim/scenario/scenario.h"
 #include "hil/sim/world/world.h"
+#include "mapping/loop/submap_icp.h"
 #include "mapping/submap/submap.h"
 #include "mapping/submap/submap_codec.h"
 
@@ -178,6 +179,13 @@ LoopMatchOutcome Score(const mapping::SubmapMatchResult& r, const mapping::Subma
   out.rotation_error_deg = dtheta.norm() / kDeg;
   out.yaw_error_deg =
       std::abs(std::remainder(YawOf(r.T_a_b.linear()) - YawOf(truth.linear()), 2 * M_PI)) / kDeg;
+  out.inliers_on_a_line = r.inliers_on_a_line;
+  out.icp_sigma_xy_m = std::sqrt(std::max(r.icp.covariance(0, 0), r.icp.covariance(1, 1)));
+  out.icp_sigma_yaw_deg = std::sqrt(r.icp.covariance(5, 5)) / kDeg;
+  out.initial_translation_error_m = (truth.translation() - r.T_a_b_initial.translation()).norm();
+  out.initial_yaw_error_deg =
+      std::abs(std::remainder(YawOf(r.T_a_b_initial.linear()) - YawOf(truth.linear()), 2 * M_PI)) /
+      kDeg;
   out.valid = r.accepted && out.translation_error_m <= o.valid_translation_m &&
               out.rotation_error_deg <= o.valid_rotation_deg;
   if (r.accepted) {
@@ -200,8 +208,10 @@ std::string Describe(const LoopMatchOutcome& m) {
          " deg, corr " + std::to_string(m.true_correspondences) + "/" +
          std::to_string(m.correspondences) + ", inliers " + std::to_string(m.inliers) + ", rmse " +
          Num(m.icp_rmse_m, 3) + ", overlap " + Num(m.overlap_ratio, 2) + ", obstacle agreement " +
-         Num(m.obstacle_agreement, 2) + ", " + Num(m.match_ms, 0) + " ms" +
-         (m.accepted ? "" : " (" + m.rejection + ")");
+         Num(m.obstacle_agreement, 2) + ", RANSAC " + Num(m.initial_translation_error_m, 3) +
+         " m " + Num(m.initial_yaw_error_deg, 2) + " deg, ICP sigma " + Num(m.icp_sigma_xy_m, 4) +
+         " m " + Num(m.icp_sigma_yaw_deg, 3) + " deg" + (m.inliers_on_a_line ? " (line)" : "") +
+         ", " + Num(m.match_ms, 0) + " ms" + (m.accepted ? "" : " (" + m.rejection + ")");
 }
 
 struct Summary {
@@ -377,6 +387,23 @@ void EvaluateSeed(const Scenario& scenario, uint64_t seed, const LoopCommandOpti
       }
       report << "  pair " << a << "-" << b << ": overlap " << Num(overlap, 1) << " m^2\n    4D "
              << Describe(rec.four) << "\n";
+      if (o.truth_diagnostics) {
+        const mapping::SubmapIcpResult t =
+            mapping::AlignSubmaps(*ia->second, *ib->second, truth, true, o.matcher.icp);
+        const std::size_t smaller =
+            std::min(ia->second->icp_points().size(), ib->second->icp_points().size());
+        const Eigen::Vector3d d = t.T_a_b.translation() - truth.translation();
+        report << "    truth ICP: ok " << t.ok << ", moved " << Num(d.norm(), 3) << " m, rmse "
+               << Num(t.rmse_m, 3) << ", overlap "
+               << Num(static_cast<double>(t.overlap_points) /
+                          static_cast<double>(std::max<std::size_t>(1, smaller)),
+                      2)
+               << ", obstacle agreement " << t.obstacle_points_agreeing << "/"
+               << t.obstacle_points_near << ", sigma x y yaw "
+               << Num(std::sqrt(t.covariance(0, 0)), 4) << " "
+               << Num(std::sqrt(t.covariance(1, 1)), 4) << " "
+               << Num(std::sqrt(t.covariance(5, 5)) / kDeg, 3) << " deg\n";
+      }
       if (o.six_dof_baseline) report << "    6D " << Describe(rec.six) << "\n";
       result->records.push_back(rec);
     }
@@ -480,8 +507,7 @@ Subcommand AddLoopCommand(CLI::App& app) {
       [options](int64_t) { options->data.orient_normals_to_free_space = false; },
       "all normals up instead of towards the voxel space's free side");
   cmd->add_flag(
-      "--no-6d", [options](int64_t) { options->six_dof_baseline = false; },
-      "skip the 6D baseline");
+      "--no-6d", [options](int64_t) { options->six_dof_baseline = false; }, "skip the 6D baseline");
   cmd->add_option("--icp-robust-scale-m", options->matcher.icp.robust_scale_m)
       ->capture_default_str();
   cmd->add_option("--icp-final-distance-m", options->matcher.icp.final_distance_m)
@@ -490,8 +516,23 @@ Subcommand AddLoopCommand(CLI::App& app) {
   cmd->add_option("--min-obstacle-agreement", options->matcher.min_obstacle_agreement)
       ->capture_default_str();
   cmd->add_option("--min-sigma-m", options->matcher.min_sigma_m)->capture_default_str();
-  cmd->add_option("--rmse-sigma-factor", options->matcher.rmse_sigma_factor)
+  cmd->add_option("--rmse-sigma-factor", options->matcher.rmse_sigma_factor)->capture_default_str();
+  cmd->add_flag(
+      "--truth-diagnostics", [options](int64_t) { options->truth_diagnostics = true; },
+      "also run the 4D ICP from the true transform and print its checks");
+  cmd->add_option("--min-obstacle-points", options->data.min_obstacle_points)
       ->capture_default_str();
+  cmd->add_option("--min-keypoints-off-line", options->data.min_keypoints_off_line)
+      ->capture_default_str();
+  cmd->add_option("--min-inliers-off-line", options->matcher.min_inliers_off_line)
+      ->capture_default_str();
+  cmd->add_option("--min-inliers", options->matcher.min_inliers)->capture_default_str();
+  cmd->add_option("--max-line-icp-sigma-m", options->matcher.max_line_icp_sigma_m)
+      ->capture_default_str();
+  cmd->add_option("--max-line-icp-sigma-yaw-rad", options->matcher.max_line_icp_sigma_yaw_rad)
+      ->capture_default_str();
+  cmd->add_option("--max-icp-rmse-m", options->matcher.max_icp_rmse_m)->capture_default_str();
+  cmd->add_option("--min-overlap-ratio", options->matcher.min_overlap_ratio)->capture_default_str();
   cmd->add_option("--min-sigma-yaw-rad", options->matcher.min_sigma_yaw_rad)->capture_default_str();
   return {cmd, [options] { return RunLoop(*options, std::cout, std::cerr); }};
 }

@@ -46,6 +46,9 @@ struct LoopCommandOptions {
   /// 0: all pairs.
   int max_pairs_per_seed = 0;
   bool six_dof_baseline = true;
+  /// Also run the 4D ICP from the truth and print what the validity checks
+  /// see there (the pair's ceiling).
+  bool truth_diagnostics = false;
   /// If set, built submaps (cloud and voxel space) are kept here and read
   /// back on the next run with the same scenario, seed and planning, so
   /// that matcher settings can be compared without rendering again.
@@ -74,6 +77,13 @@ struct LoopMatchOutcome {
   double icp_rmse_m = 0.0;
   double overlap_ratio = 0.0;
   double obstacle_agreement = 0.0;
+  /// Of the RANSAC winner, before the ICP.
+  double initial_translation_error_m = 0.0;
+  double initial_yaw_error_deg = 0.0;
+  /// The ICP's s^2 H^-1: larger of the x, y sigmas, and yaw.
+  double icp_sigma_xy_m = 0.0;
+  double icp_sigma_yaw_deg = 0.0;
+  bool inliers_on_a_line = false;
 };
 
 struct LoopPairRecord {

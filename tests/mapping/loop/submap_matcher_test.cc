@@ -149,7 +149,7 @@ TEST_F(SubmapMatcherTest, RejectsAPriorFarOff) {
   EXPECT_GT(ErrorOf(r.T_a_b_initial, truth).translation_m, 1.0);
 }
 
-TEST_F(SubmapMatcherTest, FlatGroundAndASingleWallAreUnsuitable) {
+TEST_F(SubmapMatcherTest, FlatGroundIsUnsuitableAndAWallOnlyWithTheLineTest) {
   LoopWorld flat;
   const Built plain = Build(flat, {0.0, 0.0}, 0.0, 21);
   EXPECT_EQ(plain.data->suitability(), SubmapSuitability::kTooFewObstaclePoints)
@@ -157,15 +157,46 @@ TEST_F(SubmapMatcherTest, FlatGroundAndASingleWallAreUnsuitable) {
   LoopWorld walled;
   walled.blocks.push_back({{1.0, 1.5, -0.2}, {12.0, 1.8, 0.8}});
   const Built wall = Build(walled, {0.0, 0.0}, 0.0, 22);
-  EXPECT_EQ(wall.data->suitability(), SubmapSuitability::kKeypointsOnALine)
-      << wall.data->suitability_reason();
-  EXPECT_GT(wall.data->obstacle_point_count(), 100);
-  EXPECT_NE(wall.data->suitability_reason().find("keypoints on a line"), std::string::npos);
+  SubmapMatchDataOptions line_test;
+  line_test.min_keypoints_off_line = 10;
+  const auto strict =
+      SubmapMatchData::Build(wall.submap.submap->cloud(), wall.submap.submap->octree(), line_test);
+  EXPECT_EQ(strict->suitability(), SubmapSuitability::kKeypointsOnALine)
+      << strict->suitability_reason();
+  EXPECT_GT(strict->obstacle_point_count(), 100);
+  EXPECT_NE(strict->suitability_reason().find("keypoints on a line"), std::string::npos);
   // Never matched.
   const SubmapMatchResult r =
-      SubmapMatcher().Match(*Drive(0).data, *wall.data, MatchPrior::Unbounded());
+      SubmapMatcher().Match(*Drive(0).data, *strict, MatchPrior::Unbounded());
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.rejection.find("submap b unsuitable"), std::string::npos) << r.rejection;
+}
+
+// A straight wall on planar ground, driven along twice, the second time
+// 1.5 m further on: every keypoint lies along the wall and the whole cloud
+// leaves the shift along it free, so the ICP slides. Now that keypoints
+// along a line no longer make a submap unsuitable, such a pair must still
+// be rejected, and not accepted with the sliding result.
+TEST_F(SubmapMatcherTest, KeypointsAlongALineAreNotAcceptedWhenTheCloudSlides) {
+  LoopWorld walled;
+  walled.slope_x = 0.0;
+  walled.slope_y = 0.0;
+  walled.blocks.push_back({{-2.0, 1.5, -0.2}, {20.0, 1.8, 0.8}});
+  const Built a = Build(walled, {0.0, 0.0}, 0.0, 31);
+  const Built b = Build(walled, {1.5, 0.1}, 0.02, 32);
+  ASSERT_TRUE(a.data->suitable()) << a.data->suitability_reason();
+  ASSERT_TRUE(b.data->suitable()) << b.data->suitability_reason();
+  const Isometry3d truth = a.submap.T_world_submap.inverse() * b.submap.T_world_submap;
+  for (const MatchPrior& prior : {PriorNear(truth), MatchPrior::Unbounded(truth)}) {
+    const SubmapMatchResult r = SubmapMatcher().Match(*a.data, *b.data, prior);
+    std::printf("wall (%s): %s, error %.3f m\n", prior.bounded ? "bounded" : "unbounded",
+                r.rejection.c_str(), ErrorOf(r.T_a_b, truth).translation_m);
+    EXPECT_FALSE(r.accepted);
+    EXPECT_FALSE(r.rejection.empty());
+    if (!prior.bounded) {
+      EXPECT_NE(r.rejection.find("along a line"), std::string::npos) << r.rejection;
+    }
+  }
 }
 
 TEST_F(SubmapMatcherTest, NonFiniteInputIsAClearError) {
