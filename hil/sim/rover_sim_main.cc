@@ -292,10 +292,8 @@ int main(int argc, char** argv) {
   // The experiments, one line each (hil/sim/experiments/*_command.{h,cc}).
   namespace experiments = rover::sim::experiments;
   const std::vector<rover::cli::Subcommand> experiment_commands = {
-      experiments::AddFilterCommand(app),
-      experiments::AddNeesCommand(app),
-      experiments::AddMapCommand(app),
-      experiments::AddLoopCommand(app),
+      experiments::AddFilterCommand(app),  experiments::AddNeesCommand(app),
+      experiments::AddMapCommand(app),     experiments::AddLoopCommand(app),
       experiments::AddTerrainCommand(app),
   };
 
