@@ -613,7 +613,12 @@ void Mapd::TakeLoopMatches() {
     std::fprintf(stderr, "mapd: %s\n", problem.c_str());
   }
   for (const LoopMatch& m : loop_->TakeMatches()) {
-    if (!m.accepted) continue;
+    if (!m.accepted) {
+      std::fprintf(stderr, "mapd: submaps %lld and %lld do not match: %s (%.0f ms)\n",
+                   static_cast<long long>(m.a.index), static_cast<long long>(m.b.index),
+                   m.rejection.c_str(), m.match_ms);
+      continue;
+    }
     // How far the match moves b against the graph's estimate: the size of
     // the correction this loop closure brings.
     const Eigen::Isometry3d correction = m.prior.T_a_b.inverse() * m.T_a_b;
