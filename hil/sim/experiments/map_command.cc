@@ -138,9 +138,15 @@ void ScoreLoopClosures(const mapping::GraphLogContents& g, const sim::RoverTraje
 // factors: the logged pose's offset from its frame's logged origin (its
 // frame: the newest origin) moved with that origin.
 Eigen::Vector3d ResolvedFinalPosition(const mapping::GraphLogContents& g,
-                                      const std::vector<mapping::GraphFactorRecord>& extra) {
+                                      const std::vector<mapping::GraphFactorRecord>& extra,
+                                      double switch_sigma_scale = 1.0) {
   mapping::RoverGraph graph;
-  for (const mapping::GraphFactorRecord& f : g.factors) mapping::AddToGraph(f, &graph);
+  for (mapping::GraphFactorRecord f : g.factors) {
+    if (f.kind == mapping::FactorKind::kFrameSwitch) {
+      f.covariance *= switch_sigma_scale * switch_sigma_scale;
+    }
+    mapping::AddToGraph(f, &graph);
+  }
   for (const mapping::GraphFactorRecord& f : extra) mapping::AddToGraph(f, &graph);
   graph.Optimize();
   const log::rover_msgs::SubmapOrigin& newest = g.last_origins->origins.back();
@@ -169,6 +175,12 @@ void ScoreFalseMatches(const mapping::GraphLogContents& g, const Eigen::Isometry
   const Eigen::Vector3d with_false = T_world_graph * ResolvedFinalPosition(g, false_matches);
   r->resolved_error_pct = 100.0 * (as_logged - p_true).norm() / distance_m;
   r->false_match_error_pct = 100.0 * (with_false - p_true).norm() / distance_m;
+  if (o.switch_sigma_scale != 1.0) {
+    const Eigen::Vector3d scaled =
+        T_world_graph * ResolvedFinalPosition(g, {}, o.switch_sigma_scale);
+    report << "  re-solved with the frame switches' sigmas x" << Num(o.switch_sigma_scale, 2)
+           << ": final error " << Num(100.0 * (scaled - p_true).norm() / distance_m, 4) << " %\n";
+  }
   report << "  false matches: the logged graph re-solved: final error "
          << Num(r->resolved_error_pct, 4) << " %; with " << false_matches.size()
          << " false matches added (" << Num(100.0 * o.false_match_fraction, 0)
@@ -209,7 +221,8 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     r->slam_final_error_m = (p_est - p_true).norm();
     r->slam_final_error_pct = distance_m > 0.0 ? 100.0 * r->slam_final_error_m / distance_m
                                                : std::numeric_limits<double>::quiet_NaN();
-    if (options.false_match_fraction > 0.0 && distance_m > 0.0) {
+    if ((options.false_match_fraction > 0.0 || options.switch_sigma_scale != 1.0) &&
+        distance_m > 0.0) {
       ScoreFalseMatches(g, *T_world_graph, p_true, distance_m, options, r, report);
     }
   }
@@ -388,6 +401,11 @@ Subcommand AddMapCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.9))
       ->capture_default_str();
   cmd->add_option("--false-match-seed", options->false_match_seed)->capture_default_str();
+  cmd->add_option("--switch-sigma-scale", options->switch_sigma_scale,
+                  "also re-solve mapd's graph with the frame switches' standard deviations "
+                  "scaled by this (how much trusting the filter less would change)")
+      ->check(CLI::Range(0.1, 100.0))
+      ->capture_default_str();
   return {cmd, [options] { return RunMap(*options, std::cout, std::cerr); }};
 }
 

@@ -33,6 +33,8 @@ struct MapCommandOptions {
   /// (mapping::MakeFalseSubmapMatches); 0: not done.
   double false_match_fraction = 0.0;
   uint64_t false_match_seed = 1;
+  /// Diagnostic: also re-solve with the frame switches' sigmas scaled.
+  double switch_sigma_scale = 1.0;
 };
 
 /// What RunMap measured (for rover-launch's RESULT line).
