@@ -52,16 +52,19 @@ class DenseVoxels {
     }
   }
 
-  uint8_t At(int x, int y, int z) const { return states_[Index(x, y, z)]; }
-  /// State at a key, unknown outside the box.
-  uint8_t AtKey(const octomap::OcTreeKey& k) const {
-    const int x = static_cast<int>(k[0]) - static_cast<int>(lo_[0]);
-    const int y = static_cast<int>(k[1]) - static_cast<int>(lo_[1]);
-    const int z = static_cast<int>(k[2]) - static_cast<int>(lo_[2]);
+  /// State at box coordinates, unknown outside the box (a query's sphere
+  /// and the column above it may reach a voxel past the box's edge).
+  uint8_t At(int x, int y, int z) const {
     if (x < 0 || y < 0 || z < 0 || x >= size_[0] || y >= size_[1] || z >= size_[2]) {
       return kUnknown;
     }
-    return At(x, y, z);
+    return states_[Index(x, y, z)];
+  }
+  /// State at a key, unknown outside the box.
+  uint8_t AtKey(const octomap::OcTreeKey& k) const {
+    return At(static_cast<int>(k[0]) - static_cast<int>(lo_[0]),
+              static_cast<int>(k[1]) - static_cast<int>(lo_[1]),
+              static_cast<int>(k[2]) - static_cast<int>(lo_[2]));
   }
   const int* size() const { return size_; }
   const octomap::OcTreeKey& lo() const { return lo_; }
