@@ -8,6 +8,16 @@
 #include "core/geometry/yaw.h"
 
 namespace rover::mapping {
+namespace {
+
+// Mean of a non-empty point set.
+Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) c += p;
+  return c / static_cast<double>(points.size());
+}
+
+}  // namespace
 
 bool TwoPointYawTransform(const Eigen::Vector3d& a1, const Eigen::Vector3d& a2,
                           const Eigen::Vector3d& b1, const Eigen::Vector3d& b2,
@@ -29,14 +39,8 @@ bool TwoPointYawTransform(const Eigen::Vector3d& a1, const Eigen::Vector3d& a2,
 bool FitYawTransform(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
                      Eigen::Isometry3d* T_a_b) {
   if (a.size() != b.size() || a.size() < 2) return false;
-  Eigen::Vector3d ca = Eigen::Vector3d::Zero();
-  Eigen::Vector3d cb = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    ca += a[i];
-    cb += b[i];
-  }
-  ca /= static_cast<double>(a.size());
-  cb /= static_cast<double>(b.size());
+  const Eigen::Vector3d ca = Centroid(a);
+  const Eigen::Vector3d cb = Centroid(b);
   // Maximise sum a_i . Rz(yaw) b_i over the centred xy: yaw = atan2(S, C).
   double c = 0.0;
   double s = 0.0;
@@ -57,14 +61,8 @@ bool FitYawTransform(const std::vector<Eigen::Vector3d>& a, const std::vector<Ei
 bool FitRigidTransform(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
                        Eigen::Isometry3d* T_a_b) {
   if (a.size() != b.size() || a.size() < 3) return false;
-  Eigen::Vector3d ca = Eigen::Vector3d::Zero();
-  Eigen::Vector3d cb = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    ca += a[i];
-    cb += b[i];
-  }
-  ca /= static_cast<double>(a.size());
-  cb /= static_cast<double>(b.size());
+  const Eigen::Vector3d ca = Centroid(a);
+  const Eigen::Vector3d cb = Centroid(b);
   Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < a.size(); ++i) H += (b[i] - cb) * (a[i] - ca).transpose();
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
