@@ -42,6 +42,11 @@ std::unique_ptr<ipc::Subscriber<T>> Subscribe(ipc::Transport* transport, std::st
   return s;
 }
 
+// A percentile for the summary; 0 before there is any sample.
+double PercentileOrZero(const std::vector<double>& samples, double percent) {
+  return samples.empty() ? 0.0 : stats::Percentile(samples, percent);
+}
+
 void FillPose(const Eigen::Isometry3d& T, std::array<double, 3>* p, std::array<double, 4>* q_wxyz) {
   const Eigen::Quaterniond q(T.linear());
   *p = {T.translation().x(), T.translation().y(), T.translation().z()};
@@ -808,8 +813,8 @@ std::string Mapd::Summary() const {
   }
   if (slam_) {
     const SlamStats g = slam_->Stats();
-    const double p50 = g.update_ms.empty() ? 0.0 : stats::Percentile(g.update_ms, 50.0);
-    const double p99 = g.update_ms.empty() ? 0.0 : stats::Percentile(g.update_ms, 99.0);
+    const double p50 = PercentileOrZero(g.update_ms, 50.0);
+    const double p99 = PercentileOrZero(g.update_ms, 99.0);
     char text[240];
     std::snprintf(text, sizeof(text),
                   "  graph: %llu factors (%llu refused), %llu updates (%llu solves, %llu failed), "
@@ -823,8 +828,8 @@ std::string Mapd::Summary() const {
   }
   if (loop_) {
     const LoopCloserStats l = loop_->Stats();
-    const double data_p50 = l.data_ms.empty() ? 0.0 : stats::Percentile(l.data_ms, 50.0);
-    const double match_p50 = l.match_ms.empty() ? 0.0 : stats::Percentile(l.match_ms, 50.0);
+    const double data_p50 = PercentileOrZero(l.data_ms, 50.0);
+    const double match_p50 = PercentileOrZero(l.match_ms, 50.0);
     char text[240];
     std::snprintf(text, sizeof(text),
                   "  loop closures: %llu accepted of %llu pairs matched; %llu of %llu submaps "
