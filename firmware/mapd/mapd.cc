@@ -140,6 +140,7 @@ void MapdOptions::Validate() const {
     throw std::invalid_argument("MapdOptions.traversability_period: expected > 0 s");
   }
   local_mapper.Validate();
+  switch_noise.Validate();
   submap.Validate();
   loop.Validate();
 }
@@ -241,10 +242,11 @@ void Mapd::OnFrameSwitch(const topics::FrameSwitchMsg& record) {
     Eigen::Matrix4d covariance;
     for (int i = 0; i < 16; ++i)
       covariance(i / 4, i % 4) = record.covariance[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d p_old_new_m(record.p_old_new_m[0], record.p_old_new_m[1],
+                                      record.p_old_new_m[2]);
     mapping::GraphFactorRecord w = mapping::FrameSwitchFactor(
-        options_.robot_id, record.old_frame_id,
-        Eigen::Vector3d(record.p_old_new_m[0], record.p_old_new_m[1], record.p_old_new_m[2]),
-        record.yaw_old_new_rad, covariance);
+        options_.robot_id, record.old_frame_id, p_old_new_m, record.yaw_old_new_rad,
+        mapping::FrameSwitchCovariance(covariance, p_old_new_m, options_.switch_noise));
     w.stamp_ns = record.stamp_ns;
     if (record.new_frame_id == record.old_frame_id + 1) {
       AddFactor(std::move(w));

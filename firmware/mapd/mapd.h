@@ -34,6 +34,7 @@
 #include "firmware/mapd/slam_worker.h"
 #include "firmware/mapd/submap_trigger.h"
 #include "firmware/runtime/topics/rover_topics.h"
+#include "mapping/slam/frame_switch_noise.h"
 #include "mapping/slam/graph_log.h"
 #include "mapping/submap/submap.h"
 #include "mapping/submap/submap_options.h"
@@ -72,6 +73,9 @@ struct MapdOptions {
   /// the global map at its optimised origins.
   bool slam = true;
   mapping::RoverGraphOptions graph{};
+  /// The frame switches' covariances in the graph: the filter's plus an
+  /// odometry error per metre driven (mapping/slam/frame_switch_noise.h).
+  mapping::FrameSwitchNoiseOptions switch_noise{};
   /// This rover's id in the (team's) graph.
   int robot_id = 0;
   /// Wall time between global-pose updates handed to the graph thread.

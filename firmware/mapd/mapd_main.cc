@@ -98,6 +98,9 @@ int main(int argc, char** argv) {
         options.max_mapping_rate_hz = board.mapd.mapping_rate_hz;
       }
       if (!board.mapd.mapping) options.mapping = false;
+      options.switch_noise.along_sigma_per_m = board.mapd.switch_along_sigma_per_m;
+      options.switch_noise.across_sigma_per_m = board.mapd.switch_across_sigma_per_m;
+      options.switch_noise.yaw_sigma_rad_per_m = board.mapd.switch_yaw_sigma_rad_per_m;
       if (out_dir.empty()) out_dir = board.log.folder;
       if (app.get_option("--robot")->count() == 0) options.robot_name = board.board.name;
     } catch (const std::exception& e) {

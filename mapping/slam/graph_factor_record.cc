@@ -10,14 +10,6 @@ namespace {
 
 constexpr int kFourDof[4] = {0, 1, 2, 5};
 
-Eigen::Matrix4d FourDofBlock(const Matrix6d& C) {
-  Eigen::Matrix4d out;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) out(r, c) = C(kFourDof[r], kFourDof[c]);
-  }
-  return out;
-}
-
 bool ParseInt(std::string_view text, int64_t* out) {
   if (text.empty()) return false;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), *out);
@@ -53,6 +45,14 @@ std::string GraphFactorRecord::Describe() const {
   std::string s = std::string(ToString(kind)) + " " + a.ToString();
   if (b) s += " -> " + b->ToString();
   return s;
+}
+
+Eigen::Matrix4d FourDofBlock(const Matrix6d& C) {
+  Eigen::Matrix4d out;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) out(r, c) = C(kFourDof[r], kFourDof[c]);
+  }
+  return out;
 }
 
 GraphFactorRecord OriginPriorFactor(int robot, int64_t submap,

@@ -54,6 +54,9 @@ GraphFactorRecord OriginPriorFactor(int robot, int64_t submap,
                                     const Eigen::Isometry3d& T_world_origin,
                                     const Matrix6d& covariance);
 
+/// The [x y z yaw] block of a 6x6 covariance over [x y z roll pitch yaw].
+Eigen::Matrix4d FourDofBlock(const Matrix6d& covariance);
+
 /// w: the filter's frame switch from local frame `old_frame` to
 /// `old_frame + 1`, (p, yaw) with its 4x4 covariance over [dp; dyaw].
 GraphFactorRecord FrameSwitchFactor(int robot, int64_t old_frame,

@@ -192,6 +192,12 @@ Problem FindProblem(const BoardConfig& c) {
                              BoardMapdOptions::kMaxMappingRateHz, false, "a rate (Hz)")) {
     return p;
   }
+  for (const auto& [key, value] :
+       {std::pair{"mapd.switch_along_sigma_per_m", c.mapd.switch_along_sigma_per_m},
+        std::pair{"mapd.switch_across_sigma_per_m", c.mapd.switch_across_sigma_per_m},
+        std::pair{"mapd.switch_yaw_sigma_rad_per_m", c.mapd.switch_yaw_sigma_rad_per_m}}) {
+    if (Problem p = CheckRange(key, value, 0.0, 1.0, false, "an error per metre")) return p;
+  }
   return std::nullopt;
 }
 
@@ -343,6 +349,12 @@ BoardConfig BoardConfig::Load(const ConfigNode& root) {
     c.mapd.restart_backoff_s = mapd.Get<double>("restart_backoff_s", c.mapd.restart_backoff_s);
     c.mapd.mapping = mapd.Get<bool>("mapping", c.mapd.mapping);
     c.mapd.mapping_rate_hz = mapd.Get<double>("mapping_rate_hz", c.mapd.mapping_rate_hz);
+    c.mapd.switch_along_sigma_per_m =
+        mapd.Get<double>("switch_along_sigma_per_m", c.mapd.switch_along_sigma_per_m);
+    c.mapd.switch_across_sigma_per_m =
+        mapd.Get<double>("switch_across_sigma_per_m", c.mapd.switch_across_sigma_per_m);
+    c.mapd.switch_yaw_sigma_rad_per_m =
+        mapd.Get<double>("switch_yaw_sigma_rad_per_m", c.mapd.switch_yaw_sigma_rad_per_m);
   }
 
   if (Problem p = FindProblem(c)) FailAt(root, p->first, p->second);

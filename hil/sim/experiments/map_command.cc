@@ -134,6 +134,56 @@ void ScoreLoopClosures(const mapping::GraphLogContents& g, const sim::RoverTraje
                                                    : std::numeric_limits<double>::quiet_NaN();
 }
 
+// How the frame switches (w factors) hold against the truth: each switch's
+// error in its old frame (x: the heading at the frame's start, so mostly
+// along-track), normalised by the covariance the graph gives it. Consistent
+// covariances give a normalised RMS near 1 per axis and a mean NEES near 4.
+void ReportFrameSwitchConsistency(const mapping::GraphLogContents& g,
+                                  const sim::RoverTrajectory& trajectory,
+                                  const MissionFacts& mission, MapResult* r,
+                                  std::ostream& report) {
+  std::map<int64_t, Eigen::Isometry3d> truth;
+  for (const mapping::GraphFactorRecord& f : g.factors) {
+    if (f.kind != mapping::FactorKind::kFrameSwitch) continue;
+    const double t_s = (Time::FromNanoseconds(f.stamp_ns) - mission.start).ToSeconds();
+    const sim::TrajectorySample s = trajectory.Evaluate(t_s);
+    truth[f.a.index + 1] = FourDof(s.p_world_body, s.q_world_body.toRotationMatrix());
+  }
+  Eigen::Vector4d sum = Eigen::Vector4d::Zero(), sum_sq = Eigen::Vector4d::Zero();
+  Eigen::Vector4d normalised_sq = Eigen::Vector4d::Zero();
+  double nees_sum = 0.0, distance_sum_m = 0.0;
+  int n = 0;
+  for (const mapping::GraphFactorRecord& f : g.factors) {
+    if (f.kind != mapping::FactorKind::kFrameSwitch || !f.b) continue;
+    const auto a = truth.find(f.a.index);
+    const auto b = truth.find(f.b->index);
+    if (a == truth.end() || b == truth.end()) continue;
+    const Eigen::Isometry3d T_true = a->second.inverse() * b->second;
+    Eigen::Vector4d e;
+    e.head<3>() = f.T_a_b.translation() - T_true.translation();
+    e(3) = std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()), 2.0 * M_PI);
+    const Eigen::Matrix4d P = mapping::FourDofBlock(f.covariance);
+    sum += e;
+    sum_sq += e.cwiseAbs2();
+    normalised_sq += e.cwiseAbs2().cwiseQuotient(P.diagonal());
+    nees_sum += e.dot(P.ldlt().solve(e));
+    distance_sum_m += T_true.translation().norm();
+    ++n;
+  }
+  if (n == 0) return;
+  const Eigen::Vector4d mean = sum / n;
+  const Eigen::Vector4d sd = (sum_sq / n - mean.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+  const Eigen::Vector4d nrms = (normalised_sq / n).cwiseSqrt();
+  r->frame_switch_nees = nees_sum / n;
+  report << "  frame switches vs truth: " << n << " of " << Num(distance_sum_m / n, 2)
+         << " m; error per switch (old frame) x " << Num(mean(0), 4) << " +- " << Num(sd(0), 4)
+         << " m, y " << Num(mean(1), 4) << " +- " << Num(sd(1), 4) << " m, z " << Num(mean(2), 4)
+         << " +- " << Num(sd(2), 4) << " m, yaw " << Num(mean(3) * 180.0 / M_PI, 3) << " +- "
+         << Num(sd(3) * 180.0 / M_PI, 3) << " deg; normalised RMS x " << Num(nrms(0), 2) << " y "
+         << Num(nrms(1), 2) << " z " << Num(nrms(2), 2) << " yaw " << Num(nrms(3), 2)
+         << "; mean NEES " << Num(r->frame_switch_nees, 2) << " (consistent: 4)\n";
+}
+
 // The final global pose after re-solving the logged graph, with `extra`
 // factors: the logged pose's offset from its frame's logged origin (its
 // frame: the newest origin) moved with that origin.
@@ -199,6 +249,7 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     const mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
     for (const std::string& p : g.problems) report << "    graph: " << p << "\n";
     ScoreLoopClosures(g, trajectory, mission, T_world_local0, r);
+    ReportFrameSwitchConsistency(g, trajectory, mission, r, report);
     if (!g.last_origins) continue;
     const std::optional<Eigen::Isometry3d> T_world_graph =
         mapping::GraphInMap(*g.last_origins, *origins);
@@ -351,7 +402,8 @@ std::string MapResultFields(const MapResult& r) {
          " loop_closures=" + std::to_string(r.loop_closures) +
          " loop_closure_precision=" + Num(r.loop_closure_precision, 3) +
          " matcher_ms_p50=" + Num(r.matcher_ms_p50, 1) +
-         " graph_update_ms_p99=" + Num(r.graph_update_ms_p99, 1);
+         " graph_update_ms_p99=" + Num(r.graph_update_ms_p99, 1) +
+         " frame_switch_nees=" + Num(r.frame_switch_nees, 2);
 }
 
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err) {

@@ -57,6 +57,9 @@ struct MapResult {
   /// From mapd's log statistics (the last log that has them; nan if none).
   double matcher_ms_p50 = std::numeric_limits<double>::quiet_NaN();
   double graph_update_ms_p99 = std::numeric_limits<double>::quiet_NaN();
+  /// The frame switches' mean NEES against the truth (x, y, z, yaw: 4 when
+  /// their covariances are consistent; nan without switches).
+  double frame_switch_nees = std::numeric_limits<double>::quiet_NaN();
   uint64_t graph_origins = 0;  ///< submaps placed at the graph's origins
   /// With false_match_fraction: the logged graph re-solved as it is, and
   /// with the false matches added (final error, % of distance).
@@ -76,6 +79,7 @@ std::string MapResultFields(const MapResult& r);
 ///          obstacle_recall=... submaps=... submap_bytes_per_s=...
 ///          raw_stereo_bytes_per_s=... loop_closures=...
 ///          loop_closure_precision=... matcher_ms_p50=... graph_update_ms_p99=...
+///          frame_switch_nees=...
 /// Errors go to `err`; returns kExitBadInput for unusable input.
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err);
 

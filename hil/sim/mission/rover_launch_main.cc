@@ -90,7 +90,8 @@ void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
     std::cout << line
               << " map_precision=nan map_recall=nan obstacle_precision=nan obstacle_recall=nan "
                  "submaps=0 submap_bytes_per_s=nan raw_stereo_bytes_per_s=nan loop_closures=0 "
-                 "loop_closure_precision=nan matcher_ms_p50=nan graph_update_ms_p99=nan\n";
+                 "loop_closure_precision=nan matcher_ms_p50=nan graph_update_ms_p99=nan "
+                 "frame_switch_nees=nan\n";
   }
 }
 

@@ -149,7 +149,8 @@ TEST(BoardConfigTest, ReadsEveryKey) {
       "ipc: {roudi_wait_s: 0.5}\n"
       "health: {period_s: 0.5, stale_after_s: 2.0, rate_warn_fraction: 0, watchdog: false}\n"
       "mapd: {submap_max_distance_m: 10.0, submap_max_position_sigma_m: 0.2,"
-      " restart_backoff_s: 3.0}\n");
+      " restart_backoff_s: 3.0, switch_along_sigma_per_m: 0.004,"
+      " switch_across_sigma_per_m: 0.002, switch_yaw_sigma_rad_per_m: 0.001}\n");
   EXPECT_EQ(c.board.name, "rover-2_b");
   EXPECT_EQ(c.board.profile, BoardProfile::kReplay);
   ASSERT_TRUE(c.replay.has_value());
@@ -179,6 +180,9 @@ TEST(BoardConfigTest, ReadsEveryKey) {
   EXPECT_EQ(c.mapd.submap_max_distance_m, 10.0);
   EXPECT_EQ(c.mapd.submap_max_position_sigma_m, 0.2);
   EXPECT_EQ(c.mapd.restart_backoff_s, 3.0);
+  EXPECT_EQ(c.mapd.switch_along_sigma_per_m, 0.004);
+  EXPECT_EQ(c.mapd.switch_across_sigma_per_m, 0.002);
+  EXPECT_EQ(c.mapd.switch_yaw_sigma_rad_per_m, 0.001);
 }
 
 TEST(BoardConfigTest, PartialThreadSectionKeepsThatThreadsDefaults) {
@@ -370,6 +374,8 @@ TEST(BoardConfigTest, ValuesOutOfRangeNameTheirKey) {
        "-0.1"},
       {"log: {folder: /l}\nmapd: {restart_backoff_s: 1000}\n",
        "mapd.restart_backoff_s: expected a backoff (s) in [0, 600], found 1000"},
+      {"log: {folder: /l}\nmapd: {switch_along_sigma_per_m: -0.001}\n",
+       "mapd.switch_along_sigma_per_m: expected an error per metre in [0, 1], found -0.001"},
       {"log: {folder: /l}\nrealtime: {lock_memory: yes please}\n", "realtime.lock_memory: "},
   };
   for (const Case& c : cases) {
