@@ -18,8 +18,9 @@ void RequireNonNegative(double value, const char* key) {
 
 void FrameSwitchNoiseOptions::Validate() const {
   if (!std::isfinite(filter_sigma_scale) || filter_sigma_scale <= 0.0) {
-    throw std::invalid_argument("frame switch noise: filter_sigma_scale must be finite and > 0, got " +
-                                std::to_string(filter_sigma_scale));
+    throw std::invalid_argument(
+        "frame switch noise: filter_sigma_scale must be finite and > 0, got " +
+        std::to_string(filter_sigma_scale));
   }
   RequireNonNegative(along_sigma_per_m, "along_sigma_per_m");
   RequireNonNegative(across_sigma_per_m, "across_sigma_per_m");
@@ -46,8 +47,7 @@ Eigen::Matrix4d FrameSwitchCovariance(const Eigen::Matrix4d& filter_covariance,
   const Eigen::Matrix3d along = u * u.transpose();
   const double var_along = std::pow(options.along_sigma_per_m * d_m, 2);
   const double var_across = std::pow(options.across_sigma_per_m * d_m, 2);
-  C.topLeftCorner<3, 3>() +=
-      var_along * along + var_across * (Eigen::Matrix3d::Identity() - along);
+  C.topLeftCorner<3, 3>() += var_along * along + var_across * (Eigen::Matrix3d::Identity() - along);
   C(3, 3) += std::pow(options.yaw_sigma_rad_per_m * d_m, 2);
   return C;
 }

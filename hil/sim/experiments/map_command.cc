@@ -104,13 +104,13 @@ std::string Num(double v, int digits) {
   return text;
 }
 
-// Counts the graph's submap matches and those that hold against the truth.
-// A local frame starts at the body's position and yaw at its switch, so its
-// true origin is the true body pose then (x, y, z, yaw); frame 0's is
-// T_world_local0. A match naming a frame of unknown truth counts as invalid.
-void ScoreLoopClosures(const mapping::GraphLogContents& g, const sim::RoverTrajectory& trajectory,
-                       const MissionFacts& mission, const Eigen::Isometry3d& T_world_local0,
-                       MapResult* r) {
+// The true origins of the graph's local frames. A local frame starts at the
+// body's position and yaw at its switch, so its true origin is the true body
+// pose then (x, y, z, yaw); frame 0's is T_world_local0.
+std::map<int64_t, Eigen::Isometry3d> TrueOrigins(const mapping::GraphLogContents& g,
+                                                 const sim::RoverTrajectory& trajectory,
+                                                 const MissionFacts& mission,
+                                                 const Eigen::Isometry3d& T_world_local0) {
   std::map<int64_t, Eigen::Isometry3d> truth;
   for (const mapping::GraphFactorRecord& f : g.factors) {
     if (f.kind == mapping::FactorKind::kPrior && f.a.index == 0) truth[0] = T_world_local0;
@@ -119,6 +119,13 @@ void ScoreLoopClosures(const mapping::GraphLogContents& g, const sim::RoverTraje
     const sim::TrajectorySample s = trajectory.Evaluate(t_s);
     truth[f.a.index + 1] = FourDof(s.p_world_body, s.q_world_body.toRotationMatrix());
   }
+  return truth;
+}
+
+// Counts the graph's submap matches and those that hold against the true
+// origins. A match naming a frame of unknown truth counts as invalid.
+void ScoreLoopClosures(const mapping::GraphLogContents& g,
+                       const std::map<int64_t, Eigen::Isometry3d>& truth, MapResult* r) {
   for (const mapping::GraphFactorRecord& f : g.factors) {
     if (f.kind != mapping::FactorKind::kSubmapMatch || !f.b) continue;
     ++r->loop_closures;
@@ -139,16 +146,8 @@ void ScoreLoopClosures(const mapping::GraphLogContents& g, const sim::RoverTraje
 // along-track), normalised by the covariance the graph gives it. Consistent
 // covariances give a normalised RMS near 1 per axis and a mean NEES near 4.
 void ReportFrameSwitchConsistency(const mapping::GraphLogContents& g,
-                                  const sim::RoverTrajectory& trajectory,
-                                  const MissionFacts& mission, MapResult* r,
+                                  const std::map<int64_t, Eigen::Isometry3d>& truth, MapResult* r,
                                   std::ostream& report) {
-  std::map<int64_t, Eigen::Isometry3d> truth;
-  for (const mapping::GraphFactorRecord& f : g.factors) {
-    if (f.kind != mapping::FactorKind::kFrameSwitch) continue;
-    const double t_s = (Time::FromNanoseconds(f.stamp_ns) - mission.start).ToSeconds();
-    const sim::TrajectorySample s = trajectory.Evaluate(t_s);
-    truth[f.a.index + 1] = FourDof(s.p_world_body, s.q_world_body.toRotationMatrix());
-  }
   Eigen::Vector4d sum = Eigen::Vector4d::Zero(), sum_sq = Eigen::Vector4d::Zero();
   Eigen::Vector4d normalised_sq = Eigen::Vector4d::Zero();
   double nees_sum = 0.0, distance_sum_m = 0.0;
@@ -248,8 +247,18 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
   for (const std::string& path : mapd_logs) {
     const mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
     for (const std::string& p : g.problems) report << "    graph: " << p << "\n";
-    ScoreLoopClosures(g, trajectory, mission, T_world_local0, r);
-    ReportFrameSwitchConsistency(g, trajectory, mission, r, report);
+    const std::map<int64_t, Eigen::Isometry3d> truth =
+        TrueOrigins(g, trajectory, mission, T_world_local0);
+    ScoreLoopClosures(g, truth, r);
+    ReportFrameSwitchConsistency(g, truth, r, report);
+    if (options.true_origins) {
+      // Diagnostic: what the submaps alone are worth, with no origin error.
+      for (const auto& [frame, T_world_origin] : truth) {
+        (*origins)[static_cast<uint32_t>(frame)] = T_world_origin;
+      }
+      report << "  submaps placed at their true origins (diagnostic)\n";
+      continue;
+    }
     if (!g.last_origins) continue;
     const std::optional<Eigen::Isometry3d> T_world_graph =
         mapping::GraphInMap(*g.last_origins, *origins);
@@ -453,6 +462,9 @@ Subcommand AddMapCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.9))
       ->capture_default_str();
   cmd->add_option("--false-match-seed", options->false_match_seed)->capture_default_str();
+  cmd->add_flag("--true-origins", options->true_origins,
+                "diagnostic: compose the submaps at their true origins (the true body pose at "
+                "each frame switch), to separate the submaps' own quality from the origins' error");
   cmd->add_option("--switch-sigma-scale", options->switch_sigma_scale,
                   "also re-solve mapd's graph with the frame switches' standard deviations "
                   "scaled by this (how much trusting the filter less would change)")

@@ -35,6 +35,8 @@ struct MapCommandOptions {
   uint64_t false_match_seed = 1;
   /// Diagnostic: also re-solve with the frame switches' sigmas scaled.
   double switch_sigma_scale = 1.0;
+  /// Diagnostic: compose the submaps at their true origins.
+  bool true_origins = false;
 };
 
 /// What RunMap measured (for rover-launch's RESULT line).

@@ -75,9 +75,9 @@ TEST(FrameSwitchNoiseTest, LoadReadsTheKeysAndKeepsDefaultsForTheOthers) {
   EXPECT_EQ(o.along_sigma_per_m, 0.004);
   EXPECT_EQ(o.filter_sigma_scale, 2.0);
   EXPECT_EQ(o.across_sigma_per_m, FrameSwitchNoiseOptions{}.across_sigma_per_m);
-  EXPECT_THROW(FrameSwitchNoiseOptions::Load(
-                   ConfigNode::LoadString("across_sigma_per_m: -1\n", "test")),
-               std::invalid_argument);
+  EXPECT_THROW(
+      FrameSwitchNoiseOptions::Load(ConfigNode::LoadString("across_sigma_per_m: -1\n", "test")),
+      std::invalid_argument);
 }
 
 }  // namespace
