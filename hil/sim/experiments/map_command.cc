@@ -15,6 +15,7 @@
 #include "core/log/msgs/message_traits.h"
 #include "estimator/eskf/eskf_output.h"
 #include "hil/sim/dataset/dataset_generator.h"
+#include "hil/sim/experiments/loop_replay.h"
 #include "hil/sim/motion/rover_trajectory.h"
 #include "hil/sim/scenario/scenario.h"
 #include "mapping/compose/map_composer.h"
@@ -245,8 +246,19 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
                          std::map<uint32_t, Eigen::Isometry3d>* origins, MapResult* r,
                          std::ostream& report) {
   for (const std::string& path : mapd_logs) {
-    const mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
+    mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
     for (const std::string& p : g.problems) report << "    graph: " << p << "\n";
+    if (options.rematch) {
+      LoopReplayOptions replay;
+      replay.reapply_switch_noise = options.rematch_reapply_switch_noise;
+      replay.true_origins = TrueOrigins(g, trajectory, mission, T_world_local0);
+      const LoopReplayResult result =
+          ReplayLoopClosing(g, mapping::ReadSubmapLog(path), replay, report);
+      report << "  loop closing replayed offline: " << result.matches_accepted << " accepted of "
+             << result.pairs_matched << " pairs matched; " << result.submaps_suitable
+             << " submaps suitable\n";
+      g = result.graph;
+    }
     const std::map<int64_t, Eigen::Isometry3d> truth =
         TrueOrigins(g, trajectory, mission, T_world_local0);
     ScoreLoopClosures(g, truth, r);
@@ -462,6 +474,12 @@ Subcommand AddMapCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.9))
       ->capture_default_str();
   cmd->add_option("--false-match-seed", options->false_match_seed)->capture_default_str();
+  cmd->add_flag("--rematch", options->rematch,
+                "re-run loop closing offline on the logged submaps (mapd's pairing and matcher, "
+                "every candidate matched before the next submap) and score that graph instead");
+  cmd->add_flag("--rematch-reapply-switch-noise", options->rematch_reapply_switch_noise,
+                "with --rematch: put the logged frame switches through the default noise model "
+                "(logs written before mapd applied it)");
   cmd->add_flag("--true-origins", options->true_origins,
                 "diagnostic: compose the submaps at their true origins (the true body pose at "
                 "each frame switch), to separate the submaps' own quality from the origins' error");

@@ -37,6 +37,9 @@ struct MapCommandOptions {
   double switch_sigma_scale = 1.0;
   /// Diagnostic: compose the submaps at their true origins.
   bool true_origins = false;
+  /// Re-run loop closing offline on the logged submaps (loop_replay.h).
+  bool rematch = false;
+  bool rematch_reapply_switch_noise = false;
 };
 
 /// What RunMap measured (for rover-launch's RESULT line).

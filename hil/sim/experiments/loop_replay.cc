@@ -1,0 +1,181 @@
+#include "hil/sim/experiments/loop_replay.h"
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "core/geometry/yaw.h"
+#include "mapping/graph/rover_graph.h"
+#include "mapping/loop/submap_matcher.h"
+#include "mapping/loop/submap_pairing.h"
+
+namespace rover::sim::experiments {
+namespace {
+
+mapping::GraphFactorRecord WithSwitchNoise(const mapping::GraphFactorRecord& w,
+                                           const mapping::FrameSwitchNoiseOptions& noise) {
+  mapping::GraphFactorRecord out = mapping::FrameSwitchFactor(
+      w.a.robot, w.a.index, w.T_a_b.translation(), YawOf(w.T_a_b.linear()),
+      mapping::FrameSwitchCovariance(mapping::FourDofBlock(w.covariance), w.T_a_b.translation(),
+                                     noise));
+  out.id = w.id;
+  out.stamp_ns = w.stamp_ns;
+  return out;
+}
+
+// The replay's state: graph, pairing, matcher and the submaps' data.
+class Replay {
+ public:
+  Replay(const LoopReplayOptions& options, std::ostream& report)
+      : options_(options),
+        report_(report),
+        pairing_(options.loop.pairing),
+        matcher_(options.loop.matcher) {}
+
+  void Add(const mapping::GraphFactorRecord& f) {
+    mapping::AddToGraph(f, &graph_);
+    factors_.push_back(f);
+    if (f.kind == mapping::FactorKind::kPrior) robot_ = f.a.robot;
+  }
+
+  // Submap `frame` is finished: its data joins the pairing, then every
+  // candidate pair is matched.
+  void Finish(int64_t frame, const mapping::LoggedSubmap* submap) {
+    graph_.Optimize();
+    UpdateOrigins();
+    if (submap != nullptr) AddToPairing(frame, *submap);
+    while (std::optional<mapping::SubmapPair> pair = pairing_.Next()) Match(*pair);
+  }
+
+  mapping::RoverGraph& graph() { return graph_; }
+  std::vector<mapping::GraphFactorRecord>& factors() { return factors_; }
+  LoopReplayResult& result() { return result_; }
+
+ private:
+  void UpdateOrigins() {
+    for (const auto& [frame, data] : data_) {
+      pairing_.UpdateOrigin({robot_, frame}, graph_.Origin(robot_, frame),
+                            graph_.OriginCovariance(robot_, frame));
+    }
+  }
+
+  // The result's error against the true origins, when known.
+  std::string TruthError(const mapping::SubmapPair& pair, const mapping::SubmapMatchResult& r) {
+    const auto a = options_.true_origins.find(pair.a.index);
+    const auto b = options_.true_origins.find(pair.b.index);
+    if (a == options_.true_origins.end() || b == options_.true_origins.end()) return "";
+    const Eigen::Isometry3d T_true = a->second.inverse() * b->second;
+    const Eigen::Isometry3d error = T_true.inverse() * r.T_a_b;
+    const Eigen::Isometry3d prior_error = T_true.inverse() * pair.prior.T_a_b;
+    char text[160];
+    std::snprintf(text, sizeof(text), " (vs truth: %.3f m %.2f deg; prior %.3f m)",
+                  error.translation().norm(),
+                  Eigen::AngleAxisd(error.linear()).angle() * 180.0 / M_PI,
+                  prior_error.translation().norm());
+    if (error.translation().norm() <= 0.2 &&
+        Eigen::AngleAxisd(error.linear()).angle() <= M_PI / 180.0) {
+      if (r.accepted) ++result_.matches_valid;
+    }
+    return text;
+  }
+
+  void AddToPairing(int64_t frame, const mapping::LoggedSubmap& submap) {
+    if (!submap.cloud || !submap.octree) return;
+    std::shared_ptr<const mapping::SubmapMatchData> data;
+    try {
+      data = mapping::SubmapMatchData::Build(*submap.cloud, *submap.octree, options_.loop.data);
+    } catch (const std::exception& e) {
+      report_ << "    replay: submap " << frame << " has no matching data: " << e.what() << "\n";
+      return;
+    }
+    if (data->suitable()) ++result_.submaps_suitable;
+    pairing_.AddSubmap({robot_, frame}, *data, graph_.Origin(robot_, frame),
+                       graph_.OriginCovariance(robot_, frame));
+    data_[frame] = data;
+  }
+
+  void Match(const mapping::SubmapPair& pair) {
+    const auto a = data_.find(pair.a.index);
+    const auto b = data_.find(pair.b.index);
+    if (a == data_.end() || b == data_.end()) return;
+    const mapping::SubmapMatchResult r = matcher_.Match(*a->second, *b->second, pair.prior);
+    ++result_.pairs_matched;
+    const Eigen::Isometry3d correction = pair.prior.T_a_b.inverse() * r.T_a_b;
+    char line[320];
+    std::snprintf(line, sizeof(line), "    replay: %lld-%lld %s%s, %.2f m from the graph%s\n",
+                  static_cast<long long>(pair.a.index), static_cast<long long>(pair.b.index),
+                  r.accepted ? "accepted" : "rejected: ", r.rejection.c_str(),
+                  correction.translation().norm(), TruthError(pair, r).c_str());
+    report_ << line;
+    if (!r.accepted) return;
+    ++result_.matches_accepted;
+    mapping::GraphFactorRecord c = mapping::SubmapMatchFactor(
+        mapping::GraphKey::Origin(pair.a.robot, pair.a.index),
+        mapping::GraphKey::Origin(pair.b.robot, pair.b.index), r.T_a_b, r.covariance);
+    Add(c);
+    graph_.Optimize();
+    UpdateOrigins();
+  }
+
+  const LoopReplayOptions& options_;
+  std::ostream& report_;
+  mapping::RoverGraph graph_;
+  mapping::SubmapPairing pairing_;
+  mapping::SubmapMatcher matcher_;
+  std::vector<mapping::GraphFactorRecord> factors_;
+  std::map<int64_t, std::shared_ptr<const mapping::SubmapMatchData>> data_;
+  int robot_ = 0;
+  LoopReplayResult result_;
+};
+
+// The replayed graph's origins, and the logged final pose moved with its
+// frame's origin.
+void FinalEstimates(const mapping::GraphLogContents& logged, mapping::RoverGraph& graph,
+                    mapping::GraphLogContents* out) {
+  out->last_origins = logged.last_origins;
+  for (log::rover_msgs::SubmapOrigin& o : out->last_origins->origins) {
+    o.pose = mapping::ToPoseMsg(graph.Origin(o.robot, o.submap));
+  }
+  if (!logged.last_global_pose) return;
+  const log::rover_msgs::SubmapOrigin& newest = logged.last_origins->origins.back();
+  const Eigen::Isometry3d T_local_body = mapping::FromPoseMsg(newest.pose).inverse() *
+                                         mapping::FromPoseMsg(logged.last_global_pose->pose.pose);
+  out->last_global_pose = logged.last_global_pose;
+  out->last_global_pose->pose.pose =
+      mapping::ToPoseMsg(graph.Origin(newest.robot, newest.submap) * T_local_body);
+}
+
+}  // namespace
+
+LoopReplayResult ReplayLoopClosing(const mapping::GraphLogContents& logged,
+                                   const mapping::SubmapLog& submaps,
+                                   const LoopReplayOptions& options, std::ostream& report) {
+  if (!logged.last_origins || logged.last_origins->origins.empty()) {
+    throw std::runtime_error("loop replay: the mapd log has no optimised origins");
+  }
+  std::map<int64_t, const mapping::LoggedSubmap*> by_frame;
+  for (const mapping::LoggedSubmap& s : submaps.submaps) by_frame[s.info.frame_id] = &s;
+  Replay replay(options, report);
+  bool has_prior = false;
+  for (const mapping::GraphFactorRecord& f : logged.factors) {
+    if (f.kind == mapping::FactorKind::kPrior) {
+      replay.Add(f);
+      has_prior = true;
+    } else if (f.kind == mapping::FactorKind::kFrameSwitch && has_prior) {
+      replay.Add(options.reapply_switch_noise ? WithSwitchNoise(f, options.switch_noise) : f);
+      const auto submap = by_frame.find(f.a.index);
+      replay.Finish(f.a.index, submap == by_frame.end() ? nullptr : submap->second);
+    }
+  }
+  if (!has_prior) throw std::runtime_error("loop replay: the mapd log's graph has no prior");
+  replay.graph().Optimize();
+  LoopReplayResult result = replay.result();
+  result.graph.factors = replay.factors();
+  FinalEstimates(logged, replay.graph(), &result.graph);
+  return result;
+}
+
+}  // namespace rover::sim::experiments
