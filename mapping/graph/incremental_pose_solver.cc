@@ -301,7 +301,11 @@ class IncrementalPoseSolver::Impl {
     }
   }
 
-  IncrementalPoseSolverStats Update() {
+  // Up to `max_steps` Gauss-Newton steps, in iSAM2's order: relinearise the
+  // variables the last solve moved beyond the thresholds (and the new
+  // factors), re-factor the columns that reaches, solve; stop when the solve
+  // moves nothing beyond them (converged).
+  IncrementalPoseSolverStats Iterate(int max_steps) {
     IncrementalPoseSolverStats stats;
     const bool batch = options_.reorder_interval == 0;
     if (batch || !ordered_ || appended_since_reorder_ >= options_.reorder_interval) {
@@ -316,64 +320,66 @@ class IncrementalPoseSolver::Impl {
         }
       }
     }
-    std::set<int> touched;
-    for (const int k : pending_factors_) {
-      Linearize(k);
-      touched.insert(factors_[k].a);
-      if (factors_[k].b >= 0) touched.insert(factors_[k].b);
-    }
-    pending_factors_.clear();
-    for (stats.iterations = 0; stats.iterations < options_.max_iterations; ++stats.iterations) {
-      RecomputeBlocks(touched);
-      touched.clear();
-      try {
-        stats.refactored_columns += Refactor();
-      } catch (const std::runtime_error&) {
-        if (!exact_robust_hessian_) throw;
-        // Indefinite with the exact robust curvature: floor it, re-factor all.
-        exact_robust_hessian_ = false;
-        for (int k = 0; k < static_cast<int>(factors_.size()); ++k) {
-          if (!factors_[k].robust) continue;
-          Linearize(k);
-          touched.insert(factors_[k].a);
-          if (factors_[k].b >= 0) touched.insert(factors_[k].b);
-        }
-        RecomputeBlocks(touched);
-        touched.clear();
-        for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
-        stats.refactored_columns += Refactor();
-        ++stats.floored_robust_hessian;
-      }
-      SolveDelta();
-      std::set<int> moved = VariablesToRelinearize();
+    std::set<int> moved = VariablesToRelinearize();
+    while (true) {
       if (batch && !moved.empty()) {
         // Batch Gauss-Newton: every variable, every column, every iteration.
         for (int v = 0; v < static_cast<int>(variables_.size()); ++v) moved.insert(v);
         for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
       }
-
-      if (moved.empty()) {
+      if (moved.empty() && pending_factors_.empty() && stats.iterations > 0) {
         stats.converged = true;
-        ++stats.iterations;
         break;
       }
-      std::set<int> relinearize;
-      for (const int v : moved) {
-        Variable& var = variables_[v];
-        std::array<double, 7> x;
-        manifold_.Plus(var.theta.data(), var.delta.data(), x.data());
-        var.theta = x;
-        var.delta.setZero();
-        for (const int k : var.factors) relinearize.insert(k);
-      }
-      stats.relinearized_variables += static_cast<int>(moved.size());
-      for (const int k : relinearize) {
+      if (stats.iterations >= max_steps) break;
+      Step(moved, &stats);
+      moved = VariablesToRelinearize();
+    }
+    return stats;
+  }
+
+  // One Gauss-Newton step: moves the linearisation point of `moved` to its
+  // estimate, relinearises their factors and the new ones, re-factors, and
+  // solves for delta.
+  void Step(const std::set<int>& moved, IncrementalPoseSolverStats* stats) {
+    std::set<int> relinearize(pending_factors_.begin(), pending_factors_.end());
+    pending_factors_.clear();
+    for (const int v : moved) {
+      Variable& var = variables_[v];
+      std::array<double, 7> x;
+      manifold_.Plus(var.theta.data(), var.delta.data(), x.data());
+      var.theta = x;
+      var.delta.setZero();
+      for (const int k : var.factors) relinearize.insert(k);
+    }
+    stats->relinearized_variables += static_cast<int>(moved.size());
+    std::set<int> touched;
+    for (const int k : relinearize) {
+      Linearize(k);
+      touched.insert(factors_[k].a);
+      if (factors_[k].b >= 0) touched.insert(factors_[k].b);
+    }
+    RecomputeBlocks(touched);
+    try {
+      stats->refactored_columns += Refactor();
+    } catch (const std::runtime_error&) {
+      if (!exact_robust_hessian_) throw;
+      // Indefinite with the exact robust curvature: floor it, re-factor all.
+      exact_robust_hessian_ = false;
+      touched.clear();
+      for (int k = 0; k < static_cast<int>(factors_.size()); ++k) {
+        if (!factors_[k].robust) continue;
         Linearize(k);
         touched.insert(factors_[k].a);
         if (factors_[k].b >= 0) touched.insert(factors_[k].b);
       }
+      RecomputeBlocks(touched);
+      for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
+      stats->refactored_columns += Refactor();
+      ++stats->floored_robust_hessian;
     }
-    return stats;
+    SolveDelta();
+    ++stats->iterations;
   }
 
   // Fluid relinearisation. The residuals are linear in the translations for
@@ -512,7 +518,21 @@ void IncrementalPoseSolver::AddFactor(int a, int b, const Eigen::Isometry3d& Z,
   m.pending_factors_.push_back(k);
 }
 
-IncrementalPoseSolverStats IncrementalPoseSolver::Update() { return impl_->Update(); }
+IncrementalPoseSolverStats IncrementalPoseSolver::Update() {
+  const IncrementalPoseSolverOptions& o = impl_->options_;
+  return impl_->Iterate(o.steps_per_update > 0 ? std::min(o.steps_per_update, o.max_iterations)
+                                               : o.max_iterations);
+}
+
+IncrementalPoseSolverStats IncrementalPoseSolver::Converge() {
+  return impl_->Iterate(impl_->options_.max_iterations);
+}
+
+bool IncrementalPoseSolver::ReorderDue() const {
+  const Impl& m = *impl_;
+  return m.options_.reorder_interval == 0 || !m.ordered_ ||
+         m.appended_since_reorder_ >= m.options_.reorder_interval;
+}
 
 void IncrementalPoseSolver::Estimate(int v, double* x) const {
   const Impl::Variable& var = impl_->variables_.at(static_cast<size_t>(v));

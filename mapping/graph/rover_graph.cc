@@ -77,6 +77,7 @@ RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
       node.GetInRange<double>("relinearize_translation_m", 0.0, 100.0, o.relinearize_translation_m);
   o.reorder_interval = node.GetInRange<int>("reorder_interval", 0, 1000000, o.reorder_interval);
   o.covariance_hops = node.GetInRange<int>("covariance_hops", -1, 1000000, o.covariance_hops);
+  o.incremental_steps = node.GetInRange<int>("incremental_steps", 0, 1000, o.incremental_steps);
   o.Validate();
   return o;
 }
@@ -100,6 +101,7 @@ void RoverGraphOptions::Validate() const {
           "relinearize_translation_m", "in [0, 100]", relinearize_translation_m);
   require(reorder_interval >= 0, "reorder_interval", ">= 0", reorder_interval);
   require(covariance_hops >= -1, "covariance_hops", ">= -1", covariance_hops);
+  require(incremental_steps >= 0, "incremental_steps", ">= 0", incremental_steps);
 }
 
 struct RoverGraph::Variable {
@@ -134,6 +136,7 @@ class RoverGraph::Impl {
       io.relinearize_translation_m = options_.relinearize_translation_m;
       io.reorder_interval = options_.reorder_interval;
       io.max_iterations = std::min(options_.max_iterations, 20);
+      io.steps_per_update = options_.incremental_steps;
       io.cauchy_scale = options_.cauchy_scale;
       solver_ = std::make_unique<IncrementalPoseSolver>(io);
     }
@@ -309,6 +312,7 @@ class RoverGraph::Impl {
           !options_.compute_origin_covariances || PropagateCovariancesToNewOrigins();
       AddPendingToProblem();
       AddPendingToSolver();
+      if (solver_ && options_.reorder_interval > 0 && solver_->ReorderDue()) ReorderSolver(&out);
       out.variables = static_cast<int>(variables_.size());
       out.factors = static_cast<int>(factors_.size());
       out.converged = true;
@@ -320,6 +324,32 @@ class RoverGraph::Impl {
     }
     if (solver_ && solved_once_) return SolveIncrementally(out);
     return Solve(out);
+  }
+
+  // The incremental solver's periodic re-ordering (a full re-factorisation)
+  // on an update that only extends the graph, which otherwise costs nothing,
+  // instead of on the next loop closure, whose own work it would add to.
+  void ReorderSolver(RoverGraphSummary* out) {
+    try {
+      const IncrementalPoseSolverStats stats = solver_->Update();
+      out->refactored_columns = stats.refactored_columns;
+      CopySolverEstimates();
+    } catch (const std::runtime_error&) {
+      // Singular: start the solver over; the next loop closure decides.
+      ResetSolver();
+    }
+  }
+
+  void CopySolverEstimates() {
+    for (size_t i = 0; i < solver_keys_.size(); ++i) {
+      solver_->Estimate(static_cast<int>(i), variables_.at(solver_keys_[i]).x.data());
+    }
+  }
+
+  void ResetSolver() {
+    std::vector<const double*> x_of;
+    for (const GraphKey& key : solver_keys_) x_of.push_back(variables_.at(key).x.data());
+    solver_->ResetLinearization(x_of);
   }
 
   // Mirrors the variables and factors of the Ceres problem into the
@@ -358,15 +388,15 @@ class RoverGraph::Impl {
     } catch (const std::runtime_error&) {
       return Solve(out);  // singular system: let Ceres (with its damping) decide
     }
-    if (!stats.converged) return Solve(out);
-    for (size_t i = 0; i < solver_keys_.size(); ++i) {
-      solver_->Estimate(static_cast<int>(i), variables_.at(solver_keys_[i]).x.data());
-    }
+    // Converging updates that do not converge fall back to Ceres; with a
+    // fixed number of steps the next updates carry on from here.
+    if (!stats.converged && options_.incremental_steps == 0) return Solve(out);
+    CopySolverEstimates();
     out.solve_time_s = Seconds(start);
     out.iterations = stats.iterations;
     out.initial_cost = last_cost_;
     out.final_cost = last_cost_ = solver_->LinearizedCost();
-    out.converged = true;
+    out.converged = stats.converged;
     out.solved = true;
     out.incremental_solve = true;
     out.relinearized = stats.relinearized_variables;
@@ -431,9 +461,7 @@ class RoverGraph::Impl {
     if (solver_) {
       // The incremental solver continues from this optimum.
       AddPendingToSolver();
-      std::vector<const double*> x_of;
-      for (const GraphKey& key : solver_keys_) x_of.push_back(variables_.at(key).x.data());
-      solver_->ResetLinearization(x_of);
+      ResetSolver();
     }
     return out;
   }

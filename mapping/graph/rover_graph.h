@@ -71,6 +71,10 @@ struct RoverGraphOptions {
   /// last value (an upper bound to first order: factors only add
   /// information). -1: all origins.
   int covariance_hops = 2;
+  /// Gauss-Newton steps per incremental update: 0 iterates to convergence
+  /// (Ceres fallback if it does not); 1 is iSAM2's single step, leaving the
+  /// rest of the convergence to the next updates.
+  int incremental_steps = 0;
 
   /// Throws std::invalid_argument naming the first out-of-range key.
   void Validate() const;
