@@ -185,7 +185,7 @@ class IncrementalPoseSolver::Impl {
     for (int k = 0; k < n; ++k) pos_[var_at_[k]] = k;
     structure_.assign(n, {});
     L_.assign(n, {});
-    L_diag_.assign(n, Matrix6d::Zero());
+    L_inv_diag_.assign(n, Matrix6d::Zero());
     parent_.assign(n, -1);
     children_.assign(n, {});
     rows_.assign(n, {});
@@ -212,11 +212,13 @@ class IncrementalPoseSolver::Impl {
     }
     std::sort(structure.begin(), structure.end());
     structure.erase(std::unique(structure.begin(), structure.end()), structure.end());
-    IVec<int> dropped;
+    IVec<int> dropped, added;
     std::set_difference(structure_[k].begin(), structure_[k].end(), structure.begin(),
                         structure.end(), std::back_inserter(dropped));
+    std::set_difference(structure.begin(), structure.end(), structure_[k].begin(),
+                        structure_[k].end(), std::back_inserter(added));
     for (const int i : dropped) rows_[i].erase(k);
-    for (const int i : structure) rows_[i].insert(k);
+    for (const int i : added) rows_[i].insert(k);
     structure_[k] = std::move(structure);
 
     // Dense scratch indexed by position.
@@ -244,11 +246,14 @@ class IncrementalPoseSolver::Impl {
       throw std::runtime_error(
           "incremental solver: normal matrix not positive definite (unconstrained variable?)");
     }
-    L_diag_[k] = llt.matrixL();
-    const auto Lkk = L_diag_[k].triangularView<Eigen::Lower>();
+    // L_kk^-1 once: the solves below and in SolveDelta / MarginalCovariance
+    // become fixed-size 6x6 products (Eigen's triangular solver dispatches
+    // small blocks to its general blocked kernel, the factor's hot spot).
+    L_inv_diag_[k] = llt.matrixL().solve(Matrix6d::Identity());
+    const Matrix6d L_inv_T = L_inv_diag_[k].transpose();
     for (Matrix6d& block : acc) {
-      // X L_kk^T = A  <=>  L_kk X^T = A^T.
-      block = Lkk.solve(block.transpose()).transpose();
+      // X L_kk^T = A  <=>  X = A L_kk^-T.
+      block = (block * L_inv_T).eval();
     }
     L_[k] = std::move(acc);
     const int parent = s.empty() ? -1 : s.front();
@@ -289,14 +294,14 @@ class IncrementalPoseSolver::Impl {
     IVec<Vector6d> y(n);
     for (int k = 0; k < n; ++k) y[k] = b_[var_at_[k]];
     for (int k = 0; k < n; ++k) {
-      L_diag_[k].triangularView<Eigen::Lower>().solveInPlace(y[k]);
+      y[k] = (L_inv_diag_[k] * y[k]).eval();
       const IVec<int>& s = structure_[k];
       for (size_t t = 0; t < s.size(); ++t) y[s[t]].noalias() -= L_[k][t] * y[k];
     }
     for (int k = n - 1; k >= 0; --k) {
       const IVec<int>& s = structure_[k];
       for (size_t t = 0; t < s.size(); ++t) y[k].noalias() -= L_[k][t].transpose() * y[s[t]];
-      L_diag_[k].transpose().triangularView<Eigen::Upper>().solveInPlace(y[k]);
+      y[k] = (L_inv_diag_[k].transpose() * y[k]).eval();
       variables_[var_at_[k]].delta = y[k];
     }
   }
@@ -423,7 +428,7 @@ class IncrementalPoseSolver::Impl {
     while (!acc.empty()) {
       const auto it = acc.begin();
       const int q = it->first;
-      Matrix6d Y = L_diag_[q].triangularView<Eigen::Lower>().solve(it->second);
+      const Matrix6d Y = L_inv_diag_[q] * it->second;
       acc.erase(it);
       sigma.noalias() += Y.transpose() * Y;
       const IVec<int>& s = structure_[q];
@@ -445,11 +450,12 @@ class IncrementalPoseSolver::Impl {
   IVec<Matrix6d> H_diag_;
   IVec<Vector6d> b_;
   std::map<std::pair<int, int>, Matrix6d> H_off_;
-  // Factor L (position space): column k holds rows structure_[k] (> k).
+  // Factor L (position space): column k holds rows structure_[k] (> k);
+  // L_inv_diag_[k] is the inverse of its (lower-triangular) diagonal block.
   IVec<int> var_at_, pos_;
   IVec<IVec<int>> structure_;
   IVec<IVec<Matrix6d>> L_;
-  IVec<Matrix6d> L_diag_;
+  IVec<Matrix6d> L_inv_diag_;
   IVec<int> parent_;
   IVec<IVec<int>> children_;
   IVec<std::set<int>> rows_;
@@ -480,7 +486,7 @@ int IncrementalPoseSolver::AddVariable(const double* x) {
     m.var_at_.push_back(v);
     m.structure_.emplace_back();
     m.L_.emplace_back();
-    m.L_diag_.push_back(Matrix6d::Zero());
+    m.L_inv_diag_.push_back(Matrix6d::Zero());
     m.parent_.push_back(-1);
     m.children_.emplace_back();
     m.rows_.emplace_back();

@@ -333,6 +333,7 @@ class RoverGraph::Impl {
     try {
       const IncrementalPoseSolverStats stats = solver_->Update();
       out->refactored_columns = stats.refactored_columns;
+      out->reordered = stats.reordered;
       CopySolverEstimates();
     } catch (const std::runtime_error&) {
       // Singular: start the solver over; the next loop closure decides.
@@ -401,6 +402,7 @@ class RoverGraph::Impl {
     out.incremental_solve = true;
     out.relinearized = stats.relinearized_variables;
     out.refactored_columns = stats.refactored_columns;
+    out.reordered = stats.reordered;
     out.variables = static_cast<int>(variables_.size());
     out.factors = static_cast<int>(factors_.size());
     if (options_.compute_origin_covariances) {

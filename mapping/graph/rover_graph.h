@@ -121,6 +121,10 @@ struct RoverGraphSummary {
   int relinearized = 0;
   int refactored_columns = 0;
   int covariances_updated = 0;
+  /// The incremental solver re-ordered the graph and re-factored all of it
+  /// (every reorder_interval new variables, on an update that only extends
+  /// the graph when one is due).
+  bool reordered = false;
   /// Variables no prior reaches (e.g. a robot not yet linked to the team, or
   /// a chain broken by a refused factor): left out of the solve, with their
   /// factors, until a factor connects them.
