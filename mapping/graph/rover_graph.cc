@@ -108,6 +108,7 @@ struct RoverGraph::Variable {
   std::array<double, 7> x{0, 0, 0, 0, 0, 0, 1};
   bool initialized = false;
   bool in_problem = false;
+  bool in_solver = false;
 };
 
 struct RoverGraph::Factor {
@@ -158,6 +159,12 @@ class RoverGraph::Impl {
     bool has_prior = false;
     for (size_t k = 0; k < factors_.size(); ++k) {
       const Factor& f = factors_[k];
+      if (f.in_problem) {
+        // Both variables initialised already: nothing to propagate (this
+        // keeps an update's cost in what it added, not in the graph's size).
+        has_prior = has_prior || !f.b;
+        continue;
+      }
       if (!f.b) {
         has_prior = true;
         Variable& v = variables_.at(f.a);
@@ -174,8 +181,10 @@ class RoverGraph::Impl {
       throw GraphError(
           "gauge problem: the graph has no prior; add a prior on each robot's first origin");
     }
-    for (const auto& [key, v] : variables_) {
-      if (v.initialized) queue.push_back(key);
+    // Only the factors outside the problem can reach a variable that is not
+    // initialised yet: start from their initialised ends.
+    for (const auto& [key, factors] : adjacency) {
+      if (variables_.at(key).initialized) queue.push_back(key);
     }
     while (!queue.empty()) {
       const GraphKey key = queue.front();
@@ -193,9 +202,11 @@ class RoverGraph::Impl {
         queue.push_back(forward ? *f.b : f.a);
       }
     }
+    // Every variable has a factor; one that is not initialised has one
+    // outside the problem that is not a prior, so it is in `adjacency`.
     unanchored_.clear();
-    for (const auto& [key, v] : variables_) {
-      if (!v.initialized) unanchored_.push_back(key);
+    for (const auto& [key, factors] : adjacency) {
+      if (!variables_.at(key).initialized) unanchored_.push_back(key);
     }
   }
 
@@ -342,14 +353,14 @@ class RoverGraph::Impl {
   }
 
   void CopySolverEstimates() {
-    for (size_t i = 0; i < solver_keys_.size(); ++i) {
-      solver_->Estimate(static_cast<int>(i), variables_.at(solver_keys_[i]).x.data());
+    for (size_t i = 0; i < solver_variables_.size(); ++i) {
+      solver_->Estimate(static_cast<int>(i), solver_variables_[i]->x.data());
     }
   }
 
   void ResetSolver() {
     std::vector<const double*> x_of;
-    for (const GraphKey& key : solver_keys_) x_of.push_back(variables_.at(key).x.data());
+    for (const Variable* v : solver_variables_) x_of.push_back(v->x.data());
     solver_->ResetLinearization(x_of);
   }
 
@@ -360,9 +371,11 @@ class RoverGraph::Impl {
     std::vector<int> touched;
     if (!solver_) return touched;
     for (auto& [key, v] : variables_) {
-      if (!v.in_problem || solver_index_.count(key) != 0) continue;
+      if (!v.in_problem || v.in_solver) continue;
       solver_index_[key] = solver_->AddVariable(v.x.data());
       solver_keys_.push_back(key);
+      solver_variables_.push_back(&v);
+      v.in_solver = true;
     }
     for (Factor& f : factors_) {
       if (!f.in_problem || f.in_solver) continue;
@@ -510,7 +523,8 @@ class RoverGraph::Impl {
   const RoverGraphOptions options_;
   std::unique_ptr<IncrementalPoseSolver> solver_;
   std::map<GraphKey, int> solver_index_;
-  std::vector<GraphKey> solver_keys_;  // by solver index
+  std::vector<GraphKey> solver_keys_;        // by solver index
+  std::vector<Variable*> solver_variables_;  // the same (std::map nodes are stable)
   PoseManifold manifold_;
   ceres::CauchyLoss cauchy_;
   std::map<GraphKey, Variable> variables_;
