@@ -82,7 +82,7 @@ struct RoverGraphOptions {
   /// Keys: cauchy_scale, frame_switch_roll_pitch_sigma_rad, max_iterations,
   /// num_threads, compute_origin_covariances, incremental, incremental_solve,
   /// relinearize_rotation_rad, relinearize_translation_m, reorder_interval,
-  /// covariance_hops (all optional).
+  /// covariance_hops, incremental_steps (all optional).
   static RoverGraphOptions Load(const ConfigNode& node);
 };
 

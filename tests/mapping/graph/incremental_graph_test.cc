@@ -258,6 +258,9 @@ TEST(IncrementalGraphTest, InvalidOptionsNameTheKey) {
   o = {};
   o.covariance_hops = -2;
   EXPECT_NE(message(o).find("covariance_hops"), std::string::npos) << message(o);
+  o = {};
+  o.incremental_steps = -1;
+  EXPECT_NE(message(o).find("incremental_steps"), std::string::npos) << message(o);
   EXPECT_EQ(message(RoverGraphOptions{}), "no error");
 }
 
