@@ -48,7 +48,7 @@ class IncrementalPoseSolver::Impl {
     std::array<double, 7> theta{};
     Vector6d delta = Vector6d::Zero();
     IVec<int> factors;
-    std::set<int> neighbours;
+    IVec<int> neighbours;  // sorted, unique
   };
 
   struct Factor {
@@ -217,8 +217,14 @@ class IncrementalPoseSolver::Impl {
                         structure.end(), std::back_inserter(dropped));
     std::set_difference(structure.begin(), structure.end(), structure_[k].begin(),
                         structure_[k].end(), std::back_inserter(added));
-    for (const int i : dropped) rows_[i].erase(k);
-    for (const int i : added) rows_[i].insert(k);
+    for (const int i : dropped) {
+      IVec<int>& row = rows_[i];
+      row.erase(std::lower_bound(row.begin(), row.end(), k));
+    }
+    for (const int i : added) {
+      IVec<int>& row = rows_[i];
+      row.insert(std::lower_bound(row.begin(), row.end(), k), k);
+    }
     structure_[k] = std::move(structure);
 
     // Dense scratch indexed by position.
@@ -458,7 +464,7 @@ class IncrementalPoseSolver::Impl {
   IVec<Matrix6d> L_inv_diag_;
   IVec<int> parent_;
   IVec<IVec<int>> children_;
-  IVec<std::set<int>> rows_;
+  IVec<IVec<int>> rows_;  // sorted: the columns j < k with L_kj != 0
   IVec<int> slot_;
   std::set<int> changed_columns_;
   int appended_since_reorder_ = 0;
@@ -513,8 +519,11 @@ void IncrementalPoseSolver::AddFactor(int a, int b, const Eigen::Isometry3d& Z,
     f.prior = std::make_unique<PosePrior3dCost>(Z, information);
   } else {
     f.between = std::make_unique<RelativePose3dCost>(Z, information);
-    m.variables_[a].neighbours.insert(b);
-    m.variables_[b].neighbours.insert(a);
+    for (const auto& [v, w] : {std::pair{a, b}, std::pair{b, a}}) {
+      IVec<int>& list = m.variables_[v].neighbours;
+      const auto it = std::lower_bound(list.begin(), list.end(), w);
+      if (it == list.end() || *it != w) list.insert(it, w);
+    }
   }
   const int k = static_cast<int>(m.factors_.size());
   m.variables_[a].factors.push_back(k);
