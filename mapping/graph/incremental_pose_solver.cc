@@ -48,7 +48,7 @@ class IncrementalPoseSolver::Impl {
     std::array<double, 7> theta{};
     Vector6d delta = Vector6d::Zero();
     IVec<int> factors;
-    std::set<int> neighbours;
+    IVec<int> neighbours;  // sorted, unique
   };
 
   struct Factor {
@@ -185,7 +185,7 @@ class IncrementalPoseSolver::Impl {
     for (int k = 0; k < n; ++k) pos_[var_at_[k]] = k;
     structure_.assign(n, {});
     L_.assign(n, {});
-    L_diag_.assign(n, Matrix6d::Zero());
+    L_inv_diag_.assign(n, Matrix6d::Zero());
     parent_.assign(n, -1);
     children_.assign(n, {});
     rows_.assign(n, {});
@@ -212,11 +212,19 @@ class IncrementalPoseSolver::Impl {
     }
     std::sort(structure.begin(), structure.end());
     structure.erase(std::unique(structure.begin(), structure.end()), structure.end());
-    IVec<int> dropped;
+    IVec<int> dropped, added;
     std::set_difference(structure_[k].begin(), structure_[k].end(), structure.begin(),
                         structure.end(), std::back_inserter(dropped));
-    for (const int i : dropped) rows_[i].erase(k);
-    for (const int i : structure) rows_[i].insert(k);
+    std::set_difference(structure.begin(), structure.end(), structure_[k].begin(),
+                        structure_[k].end(), std::back_inserter(added));
+    for (const int i : dropped) {
+      IVec<int>& row = rows_[i];
+      row.erase(std::lower_bound(row.begin(), row.end(), k));
+    }
+    for (const int i : added) {
+      IVec<int>& row = rows_[i];
+      row.insert(std::lower_bound(row.begin(), row.end(), k), k);
+    }
     structure_[k] = std::move(structure);
 
     // Dense scratch indexed by position.
@@ -244,11 +252,14 @@ class IncrementalPoseSolver::Impl {
       throw std::runtime_error(
           "incremental solver: normal matrix not positive definite (unconstrained variable?)");
     }
-    L_diag_[k] = llt.matrixL();
-    const auto Lkk = L_diag_[k].triangularView<Eigen::Lower>();
+    // L_kk^-1 once: the solves below and in SolveDelta / MarginalCovariance
+    // become fixed-size 6x6 products (Eigen's triangular solver dispatches
+    // small blocks to its general blocked kernel, the factor's hot spot).
+    L_inv_diag_[k] = llt.matrixL().solve(Matrix6d::Identity());
+    const Matrix6d L_inv_T = L_inv_diag_[k].transpose();
     for (Matrix6d& block : acc) {
-      // X L_kk^T = A  <=>  L_kk X^T = A^T.
-      block = Lkk.solve(block.transpose()).transpose();
+      // X L_kk^T = A  <=>  X = A L_kk^-T.
+      block = (block * L_inv_T).eval();
     }
     L_[k] = std::move(acc);
     const int parent = s.empty() ? -1 : s.front();
@@ -289,19 +300,23 @@ class IncrementalPoseSolver::Impl {
     IVec<Vector6d> y(n);
     for (int k = 0; k < n; ++k) y[k] = b_[var_at_[k]];
     for (int k = 0; k < n; ++k) {
-      L_diag_[k].triangularView<Eigen::Lower>().solveInPlace(y[k]);
+      y[k] = (L_inv_diag_[k] * y[k]).eval();
       const IVec<int>& s = structure_[k];
       for (size_t t = 0; t < s.size(); ++t) y[s[t]].noalias() -= L_[k][t] * y[k];
     }
     for (int k = n - 1; k >= 0; --k) {
       const IVec<int>& s = structure_[k];
       for (size_t t = 0; t < s.size(); ++t) y[k].noalias() -= L_[k][t].transpose() * y[s[t]];
-      L_diag_[k].transpose().triangularView<Eigen::Upper>().solveInPlace(y[k]);
+      y[k] = (L_inv_diag_[k].transpose() * y[k]).eval();
       variables_[var_at_[k]].delta = y[k];
     }
   }
 
-  IncrementalPoseSolverStats Update() {
+  // Up to `max_steps` Gauss-Newton steps, in iSAM2's order: relinearise the
+  // variables the last solve moved beyond the thresholds (and the new
+  // factors), re-factor the columns that reaches, solve; stop when the solve
+  // moves nothing beyond them (converged).
+  IncrementalPoseSolverStats Iterate(int max_steps) {
     IncrementalPoseSolverStats stats;
     const bool batch = options_.reorder_interval == 0;
     if (batch || !ordered_ || appended_since_reorder_ >= options_.reorder_interval) {
@@ -316,64 +331,66 @@ class IncrementalPoseSolver::Impl {
         }
       }
     }
-    std::set<int> touched;
-    for (const int k : pending_factors_) {
-      Linearize(k);
-      touched.insert(factors_[k].a);
-      if (factors_[k].b >= 0) touched.insert(factors_[k].b);
-    }
-    pending_factors_.clear();
-    for (stats.iterations = 0; stats.iterations < options_.max_iterations; ++stats.iterations) {
-      RecomputeBlocks(touched);
-      touched.clear();
-      try {
-        stats.refactored_columns += Refactor();
-      } catch (const std::runtime_error&) {
-        if (!exact_robust_hessian_) throw;
-        // Indefinite with the exact robust curvature: floor it, re-factor all.
-        exact_robust_hessian_ = false;
-        for (int k = 0; k < static_cast<int>(factors_.size()); ++k) {
-          if (!factors_[k].robust) continue;
-          Linearize(k);
-          touched.insert(factors_[k].a);
-          if (factors_[k].b >= 0) touched.insert(factors_[k].b);
-        }
-        RecomputeBlocks(touched);
-        touched.clear();
-        for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
-        stats.refactored_columns += Refactor();
-        ++stats.floored_robust_hessian;
-      }
-      SolveDelta();
-      std::set<int> moved = VariablesToRelinearize();
+    std::set<int> moved = VariablesToRelinearize();
+    while (true) {
       if (batch && !moved.empty()) {
         // Batch Gauss-Newton: every variable, every column, every iteration.
         for (int v = 0; v < static_cast<int>(variables_.size()); ++v) moved.insert(v);
         for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
       }
-
-      if (moved.empty()) {
+      if (moved.empty() && pending_factors_.empty() && stats.iterations > 0) {
         stats.converged = true;
-        ++stats.iterations;
         break;
       }
-      std::set<int> relinearize;
-      for (const int v : moved) {
-        Variable& var = variables_[v];
-        std::array<double, 7> x;
-        manifold_.Plus(var.theta.data(), var.delta.data(), x.data());
-        var.theta = x;
-        var.delta.setZero();
-        for (const int k : var.factors) relinearize.insert(k);
-      }
-      stats.relinearized_variables += static_cast<int>(moved.size());
-      for (const int k : relinearize) {
+      if (stats.iterations >= max_steps) break;
+      Step(moved, &stats);
+      moved = VariablesToRelinearize();
+    }
+    return stats;
+  }
+
+  // One Gauss-Newton step: moves the linearisation point of `moved` to its
+  // estimate, relinearises their factors and the new ones, re-factors, and
+  // solves for delta.
+  void Step(const std::set<int>& moved, IncrementalPoseSolverStats* stats) {
+    std::set<int> relinearize(pending_factors_.begin(), pending_factors_.end());
+    pending_factors_.clear();
+    for (const int v : moved) {
+      Variable& var = variables_[v];
+      std::array<double, 7> x;
+      manifold_.Plus(var.theta.data(), var.delta.data(), x.data());
+      var.theta = x;
+      var.delta.setZero();
+      for (const int k : var.factors) relinearize.insert(k);
+    }
+    stats->relinearized_variables += static_cast<int>(moved.size());
+    std::set<int> touched;
+    for (const int k : relinearize) {
+      Linearize(k);
+      touched.insert(factors_[k].a);
+      if (factors_[k].b >= 0) touched.insert(factors_[k].b);
+    }
+    RecomputeBlocks(touched);
+    try {
+      stats->refactored_columns += Refactor();
+    } catch (const std::runtime_error&) {
+      if (!exact_robust_hessian_) throw;
+      // Indefinite with the exact robust curvature: floor it, re-factor all.
+      exact_robust_hessian_ = false;
+      touched.clear();
+      for (int k = 0; k < static_cast<int>(factors_.size()); ++k) {
+        if (!factors_[k].robust) continue;
         Linearize(k);
         touched.insert(factors_[k].a);
         if (factors_[k].b >= 0) touched.insert(factors_[k].b);
       }
+      RecomputeBlocks(touched);
+      for (int k = 0; k < static_cast<int>(variables_.size()); ++k) changed_columns_.insert(k);
+      stats->refactored_columns += Refactor();
+      ++stats->floored_robust_hessian;
     }
-    return stats;
+    SolveDelta();
+    ++stats->iterations;
   }
 
   // Fluid relinearisation. The residuals are linear in the translations for
@@ -417,7 +434,7 @@ class IncrementalPoseSolver::Impl {
     while (!acc.empty()) {
       const auto it = acc.begin();
       const int q = it->first;
-      Matrix6d Y = L_diag_[q].triangularView<Eigen::Lower>().solve(it->second);
+      const Matrix6d Y = L_inv_diag_[q] * it->second;
       acc.erase(it);
       sigma.noalias() += Y.transpose() * Y;
       const IVec<int>& s = structure_[q];
@@ -439,14 +456,15 @@ class IncrementalPoseSolver::Impl {
   IVec<Matrix6d> H_diag_;
   IVec<Vector6d> b_;
   std::map<std::pair<int, int>, Matrix6d> H_off_;
-  // Factor L (position space): column k holds rows structure_[k] (> k).
+  // Factor L (position space): column k holds rows structure_[k] (> k);
+  // L_inv_diag_[k] is the inverse of its (lower-triangular) diagonal block.
   IVec<int> var_at_, pos_;
   IVec<IVec<int>> structure_;
   IVec<IVec<Matrix6d>> L_;
-  IVec<Matrix6d> L_diag_;
+  IVec<Matrix6d> L_inv_diag_;
   IVec<int> parent_;
   IVec<IVec<int>> children_;
-  IVec<std::set<int>> rows_;
+  IVec<IVec<int>> rows_;  // sorted: the columns j < k with L_kj != 0
   IVec<int> slot_;
   std::set<int> changed_columns_;
   int appended_since_reorder_ = 0;
@@ -474,7 +492,7 @@ int IncrementalPoseSolver::AddVariable(const double* x) {
     m.var_at_.push_back(v);
     m.structure_.emplace_back();
     m.L_.emplace_back();
-    m.L_diag_.push_back(Matrix6d::Zero());
+    m.L_inv_diag_.push_back(Matrix6d::Zero());
     m.parent_.push_back(-1);
     m.children_.emplace_back();
     m.rows_.emplace_back();
@@ -501,8 +519,11 @@ void IncrementalPoseSolver::AddFactor(int a, int b, const Eigen::Isometry3d& Z,
     f.prior = std::make_unique<PosePrior3dCost>(Z, information);
   } else {
     f.between = std::make_unique<RelativePose3dCost>(Z, information);
-    m.variables_[a].neighbours.insert(b);
-    m.variables_[b].neighbours.insert(a);
+    for (const auto& [v, w] : {std::pair{a, b}, std::pair{b, a}}) {
+      IVec<int>& list = m.variables_[v].neighbours;
+      const auto it = std::lower_bound(list.begin(), list.end(), w);
+      if (it == list.end() || *it != w) list.insert(it, w);
+    }
   }
   const int k = static_cast<int>(m.factors_.size());
   m.variables_[a].factors.push_back(k);
@@ -512,7 +533,21 @@ void IncrementalPoseSolver::AddFactor(int a, int b, const Eigen::Isometry3d& Z,
   m.pending_factors_.push_back(k);
 }
 
-IncrementalPoseSolverStats IncrementalPoseSolver::Update() { return impl_->Update(); }
+IncrementalPoseSolverStats IncrementalPoseSolver::Update() {
+  const IncrementalPoseSolverOptions& o = impl_->options_;
+  return impl_->Iterate(o.steps_per_update > 0 ? std::min(o.steps_per_update, o.max_iterations)
+                                               : o.max_iterations);
+}
+
+IncrementalPoseSolverStats IncrementalPoseSolver::Converge() {
+  return impl_->Iterate(impl_->options_.max_iterations);
+}
+
+bool IncrementalPoseSolver::ReorderDue() const {
+  const Impl& m = *impl_;
+  return m.options_.reorder_interval == 0 || !m.ordered_ ||
+         m.appended_since_reorder_ >= m.options_.reorder_interval;
+}
 
 void IncrementalPoseSolver::Estimate(int v, double* x) const {
   const Impl::Variable& var = impl_->variables_.at(static_cast<size_t>(v));

@@ -12,7 +12,8 @@
 //     ordering) that the change reaches: the changed columns and their
 //     ancestors in the elimination tree,
 //   - solves for delta, relinearises only the variables whose delta exceeds a
-//     threshold (and their factors), and repeats until none does.
+//     threshold (and their factors), and repeats until none does (or for a
+//     fixed number of steps, iSAM2's one per update; see steps_per_update).
 // The ordering is Eigen's approximate minimum degree on the older variables
 // with the newest ones last (as iSAM2 constrains CCOLAMD: new factors touch
 // them, and their columns near the root have few ancestors); variables added
@@ -49,6 +50,10 @@ struct IncrementalPoseSolverOptions {
   /// Steps below this (any unit) never trigger relinearisation.
   double step_tolerance = 1e-6;
   int max_iterations = 10;
+  /// Gauss-Newton steps per Update(): 0 iterates until converged (at most
+  /// max_iterations); 1 is iSAM2's one step per update, the rest of the
+  /// convergence left to the next updates (or Converge()).
+  int steps_per_update = 0;
   /// New variables appended at the end of the ordering before the graph is
   /// re-ordered (full re-factorisation). 0: re-order and re-factor everything
   /// at every update (batch).
@@ -82,9 +87,18 @@ class IncrementalPoseSolver {
   void AddFactor(int a, int b, const Eigen::Isometry3d& Z, const Matrix6d& information,
                  bool robust);
 
-  /// Gauss-Newton with fluid relinearisation until converged or
-  /// max_iterations. Throws std::runtime_error if the system is singular.
+  /// Gauss-Newton with fluid relinearisation: options.steps_per_update
+  /// steps, or (0) until converged or max_iterations. Each step relinearises
+  /// what the previous one moved beyond the thresholds (the first: what the
+  /// last update left). Throws std::runtime_error if the system is singular.
   IncrementalPoseSolverStats Update();
+
+  /// Steps until converged or max_iterations (after one-step updates).
+  IncrementalPoseSolverStats Converge();
+
+  /// True when the next Update() re-orders the graph and re-factors all of
+  /// it (reorder_interval variables appended since the last re-ordering).
+  bool ReorderDue() const;
 
   /// Current estimate theta (+) delta of variable v into x (7 doubles).
   void Estimate(int v, double* x) const;

@@ -77,6 +77,7 @@ RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
       node.GetInRange<double>("relinearize_translation_m", 0.0, 100.0, o.relinearize_translation_m);
   o.reorder_interval = node.GetInRange<int>("reorder_interval", 0, 1000000, o.reorder_interval);
   o.covariance_hops = node.GetInRange<int>("covariance_hops", -1, 1000000, o.covariance_hops);
+  o.incremental_steps = node.GetInRange<int>("incremental_steps", 0, 1000, o.incremental_steps);
   o.Validate();
   return o;
 }
@@ -100,12 +101,14 @@ void RoverGraphOptions::Validate() const {
           "relinearize_translation_m", "in [0, 100]", relinearize_translation_m);
   require(reorder_interval >= 0, "reorder_interval", ">= 0", reorder_interval);
   require(covariance_hops >= -1, "covariance_hops", ">= -1", covariance_hops);
+  require(incremental_steps >= 0, "incremental_steps", ">= 0", incremental_steps);
 }
 
 struct RoverGraph::Variable {
   std::array<double, 7> x{0, 0, 0, 0, 0, 0, 1};
   bool initialized = false;
   bool in_problem = false;
+  bool in_solver = false;
 };
 
 struct RoverGraph::Factor {
@@ -134,6 +137,7 @@ class RoverGraph::Impl {
       io.relinearize_translation_m = options_.relinearize_translation_m;
       io.reorder_interval = options_.reorder_interval;
       io.max_iterations = std::min(options_.max_iterations, 20);
+      io.steps_per_update = options_.incremental_steps;
       io.cauchy_scale = options_.cauchy_scale;
       solver_ = std::make_unique<IncrementalPoseSolver>(io);
     }
@@ -155,6 +159,12 @@ class RoverGraph::Impl {
     bool has_prior = false;
     for (size_t k = 0; k < factors_.size(); ++k) {
       const Factor& f = factors_[k];
+      if (f.in_problem) {
+        // Both variables initialised already: nothing to propagate (this
+        // keeps an update's cost in what it added, not in the graph's size).
+        has_prior = has_prior || !f.b;
+        continue;
+      }
       if (!f.b) {
         has_prior = true;
         Variable& v = variables_.at(f.a);
@@ -171,8 +181,10 @@ class RoverGraph::Impl {
       throw GraphError(
           "gauge problem: the graph has no prior; add a prior on each robot's first origin");
     }
-    for (const auto& [key, v] : variables_) {
-      if (v.initialized) queue.push_back(key);
+    // Only the factors outside the problem can reach a variable that is not
+    // initialised yet: start from their initialised ends.
+    for (const auto& [key, factors] : adjacency) {
+      if (variables_.at(key).initialized) queue.push_back(key);
     }
     while (!queue.empty()) {
       const GraphKey key = queue.front();
@@ -190,9 +202,11 @@ class RoverGraph::Impl {
         queue.push_back(forward ? *f.b : f.a);
       }
     }
+    // Every variable has a factor; one that is not initialised has one
+    // outside the problem that is not a prior, so it is in `adjacency`.
     unanchored_.clear();
-    for (const auto& [key, v] : variables_) {
-      if (!v.initialized) unanchored_.push_back(key);
+    for (const auto& [key, factors] : adjacency) {
+      if (!variables_.at(key).initialized) unanchored_.push_back(key);
     }
   }
 
@@ -309,6 +323,7 @@ class RoverGraph::Impl {
           !options_.compute_origin_covariances || PropagateCovariancesToNewOrigins();
       AddPendingToProblem();
       AddPendingToSolver();
+      if (solver_ && options_.reorder_interval > 0 && solver_->ReorderDue()) ReorderSolver(&out);
       out.variables = static_cast<int>(variables_.size());
       out.factors = static_cast<int>(factors_.size());
       out.converged = true;
@@ -322,6 +337,33 @@ class RoverGraph::Impl {
     return Solve(out);
   }
 
+  // The incremental solver's periodic re-ordering (a full re-factorisation)
+  // on an update that only extends the graph, which otherwise costs nothing,
+  // instead of on the next loop closure, whose own work it would add to.
+  void ReorderSolver(RoverGraphSummary* out) {
+    try {
+      const IncrementalPoseSolverStats stats = solver_->Update();
+      out->refactored_columns = stats.refactored_columns;
+      out->reordered = stats.reordered;
+      CopySolverEstimates();
+    } catch (const std::runtime_error&) {
+      // Singular: start the solver over; the next loop closure decides.
+      ResetSolver();
+    }
+  }
+
+  void CopySolverEstimates() {
+    for (size_t i = 0; i < solver_variables_.size(); ++i) {
+      solver_->Estimate(static_cast<int>(i), solver_variables_[i]->x.data());
+    }
+  }
+
+  void ResetSolver() {
+    std::vector<const double*> x_of;
+    for (const Variable* v : solver_variables_) x_of.push_back(v->x.data());
+    solver_->ResetLinearization(x_of);
+  }
+
   // Mirrors the variables and factors of the Ceres problem into the
   // incremental solver; returns the solver indices of the new factors'
   // variables (where the marginals change most).
@@ -329,9 +371,11 @@ class RoverGraph::Impl {
     std::vector<int> touched;
     if (!solver_) return touched;
     for (auto& [key, v] : variables_) {
-      if (!v.in_problem || solver_index_.count(key) != 0) continue;
+      if (!v.in_problem || v.in_solver) continue;
       solver_index_[key] = solver_->AddVariable(v.x.data());
       solver_keys_.push_back(key);
+      solver_variables_.push_back(&v);
+      v.in_solver = true;
     }
     for (Factor& f : factors_) {
       if (!f.in_problem || f.in_solver) continue;
@@ -358,19 +402,20 @@ class RoverGraph::Impl {
     } catch (const std::runtime_error&) {
       return Solve(out);  // singular system: let Ceres (with its damping) decide
     }
-    if (!stats.converged) return Solve(out);
-    for (size_t i = 0; i < solver_keys_.size(); ++i) {
-      solver_->Estimate(static_cast<int>(i), variables_.at(solver_keys_[i]).x.data());
-    }
+    // Converging updates that do not converge fall back to Ceres; with a
+    // fixed number of steps the next updates carry on from here.
+    if (!stats.converged && options_.incremental_steps == 0) return Solve(out);
+    CopySolverEstimates();
     out.solve_time_s = Seconds(start);
     out.iterations = stats.iterations;
     out.initial_cost = last_cost_;
     out.final_cost = last_cost_ = solver_->LinearizedCost();
-    out.converged = true;
+    out.converged = stats.converged;
     out.solved = true;
     out.incremental_solve = true;
     out.relinearized = stats.relinearized_variables;
     out.refactored_columns = stats.refactored_columns;
+    out.reordered = stats.reordered;
     out.variables = static_cast<int>(variables_.size());
     out.factors = static_cast<int>(factors_.size());
     if (options_.compute_origin_covariances) {
@@ -431,9 +476,7 @@ class RoverGraph::Impl {
     if (solver_) {
       // The incremental solver continues from this optimum.
       AddPendingToSolver();
-      std::vector<const double*> x_of;
-      for (const GraphKey& key : solver_keys_) x_of.push_back(variables_.at(key).x.data());
-      solver_->ResetLinearization(x_of);
+      ResetSolver();
     }
     return out;
   }
@@ -480,7 +523,8 @@ class RoverGraph::Impl {
   const RoverGraphOptions options_;
   std::unique_ptr<IncrementalPoseSolver> solver_;
   std::map<GraphKey, int> solver_index_;
-  std::vector<GraphKey> solver_keys_;  // by solver index
+  std::vector<GraphKey> solver_keys_;        // by solver index
+  std::vector<Variable*> solver_variables_;  // the same (std::map nodes are stable)
   PoseManifold manifold_;
   ceres::CauchyLoss cauchy_;
   std::map<GraphKey, Variable> variables_;

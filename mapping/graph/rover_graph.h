@@ -71,6 +71,10 @@ struct RoverGraphOptions {
   /// last value (an upper bound to first order: factors only add
   /// information). -1: all origins.
   int covariance_hops = 2;
+  /// Gauss-Newton steps per incremental update: 0 iterates to convergence
+  /// (Ceres fallback if it does not); 1 is iSAM2's single step, leaving the
+  /// rest of the convergence to the next updates.
+  int incremental_steps = 0;
 
   /// Throws std::invalid_argument naming the first out-of-range key.
   void Validate() const;
@@ -78,7 +82,7 @@ struct RoverGraphOptions {
   /// Keys: cauchy_scale, frame_switch_roll_pitch_sigma_rad, max_iterations,
   /// num_threads, compute_origin_covariances, incremental, incremental_solve,
   /// relinearize_rotation_rad, relinearize_translation_m, reorder_interval,
-  /// covariance_hops (all optional).
+  /// covariance_hops, incremental_steps (all optional).
   static RoverGraphOptions Load(const ConfigNode& node);
 };
 
@@ -117,6 +121,10 @@ struct RoverGraphSummary {
   int relinearized = 0;
   int refactored_columns = 0;
   int covariances_updated = 0;
+  /// The incremental solver re-ordered the graph and re-factored all of it
+  /// (every reorder_interval new variables, on an update that only extends
+  /// the graph when one is due).
+  bool reordered = false;
   /// Variables no prior reaches (e.g. a robot not yet linked to the team, or
   /// a chain broken by a refused factor): left out of the solve, with their
   /// factors, until a factor connects them.

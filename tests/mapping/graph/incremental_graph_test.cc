@@ -92,6 +92,89 @@ TEST(IncrementalPoseSolverTest, PartialRefactorisationMatchesFullRefactorisation
   }
 }
 
+// iSAM2-style updates (one Gauss-Newton step each) leave part of the
+// convergence to later updates; Converge() finishes it. With thresholds that
+// relinearise every move, both end at the same optimum as updates that
+// converge every time.
+TEST(IncrementalPoseSolverTest, OneStepUpdatesThenConvergeReachTheConvergedSolution) {
+  std::mt19937 rng(5);
+  IncrementalPoseSolverOptions converging_options;
+  converging_options.relinearize_rotation_rad = 0.0;
+  converging_options.relinearize_translation_m = 0.0;
+  converging_options.max_iterations = 50;
+  IncrementalPoseSolverOptions one_step_options = converging_options;
+  one_step_options.steps_per_update = 1;
+  IncrementalPoseSolver converging(converging_options), one_step(one_step_options);
+  const Matrix6d information = 100.0 * Matrix6d::Identity();
+  std::vector<Eigen::Isometry3d> truth = {Eigen::Isometry3d::Identity()};
+  std::array<double, 7> x;
+  PoseToParameters(truth[0], x.data());
+  for (IncrementalPoseSolver* s : {&converging, &one_step}) {
+    s->AddVariable(x.data());
+    s->AddFactor(0, -1, truth[0], 1e6 * Matrix6d::Identity(), false);
+  }
+  int unconverged_steps = 0;
+  for (int i = 1; i < 120; ++i) {
+    const Eigen::Isometry3d step = RandomPose(rng, 0.5, 0.1);
+    truth.push_back(truth.back() * step);
+    const Eigen::Isometry3d odometry = step * RandomPose(rng, 0.02, 0.002);
+    // Loops a few steps back: inliers of the Cauchy loss.
+    const int j = std::max(0, i - std::uniform_int_distribution<int>(3, 8)(rng));
+    const Eigen::Isometry3d loop =
+        truth[static_cast<size_t>(j)].inverse() * truth.back() * RandomPose(rng, 0.02, 0.002);
+    for (IncrementalPoseSolver* s : {&converging, &one_step}) {
+      // Initialised by odometry from the current estimate, as RoverGraph does.
+      s->Estimate(i - 1, x.data());
+      PoseToParameters(PoseFromParameters(x.data()) * odometry, x.data());
+      s->AddVariable(x.data());
+      s->AddFactor(i - 1, i, odometry, information, false);
+      if (i % 6 == 0) s->AddFactor(j, i, loop, information, true);
+    }
+    if (i % 3 != 0) continue;
+    ASSERT_TRUE(converging.Update().converged);
+    const IncrementalPoseSolverStats stats = one_step.Update();
+    EXPECT_EQ(stats.iterations, 1);
+    unconverged_steps += stats.converged ? 0 : 1;
+  }
+  EXPECT_GT(unconverged_steps, 0);  // the one-step updates did leave work
+  ASSERT_TRUE(one_step.Converge().converged);
+  for (int v = 0; v < converging.num_variables(); ++v) {
+    std::array<double, 7> a, b;
+    converging.Estimate(v, a.data());
+    one_step.Estimate(v, b.data());
+    const Eigen::Isometry3d A = PoseFromParameters(a.data());
+    const Eigen::Isometry3d B = PoseFromParameters(b.data());
+    EXPECT_LT((A.translation() - B.translation()).norm(), 1e-6) << "variable " << v;
+    EXPECT_LT(LogSO3(A.linear().transpose() * B.linear()).norm(), 1e-6) << "variable " << v;
+  }
+}
+
+// The periodic re-ordering (a full re-factorisation) is done on updates that
+// only extend the graph, never on a loop-closing update, once the solver runs.
+TEST(IncrementalGraphTest, ReorderingHappensOnExtensionUpdates) {
+  SyntheticSubmapTrajectoryOptions so;
+  so.submaps = 200;
+  const SyntheticSubmapTrajectory traj = MakeSyntheticSubmapTrajectory(so, 4);
+  RoverGraph graph;
+  traj.AddPrior(&graph);
+  graph.Optimize();
+  int reorders = 0, incremental_loop_updates = 0;
+  for (size_t i = 0; i < traj.steps.size(); ++i) {
+    const int loops = traj.AddStep(i, &graph);
+    const RoverGraphSummary s = graph.Optimize();
+    if (s.reordered) {
+      ++reorders;
+      EXPECT_FALSE(s.solved) << "update " << i;
+      EXPECT_EQ(loops, 0) << "update " << i;
+      EXPECT_EQ(s.refactored_columns, s.variables) << "update " << i;
+    }
+    if (loops > 0 && s.incremental_solve) ++incremental_loop_updates;
+  }
+  // 2 variables per submap, re-ordered every 100: one per 50 submaps.
+  EXPECT_GE(reorders, 3);
+  EXPECT_GT(incremental_loop_updates, 10);
+}
+
 // After every update of seeded 300-submap sequences (frame switches, filter
 // poses, loop closures every few submaps), all origins agree with full Ceres
 // solves within 1 mm / 0.01 deg, and every loop closure was incremental.
@@ -175,6 +258,9 @@ TEST(IncrementalGraphTest, InvalidOptionsNameTheKey) {
   o = {};
   o.covariance_hops = -2;
   EXPECT_NE(message(o).find("covariance_hops"), std::string::npos) << message(o);
+  o = {};
+  o.incremental_steps = -1;
+  EXPECT_NE(message(o).find("incremental_steps"), std::string::npos) << message(o);
   EXPECT_EQ(message(RoverGraphOptions{}), "no error");
 }
 
