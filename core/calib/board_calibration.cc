@@ -64,6 +64,7 @@ CameraModel LoadCamera(const ConfigNode& n) {
   c.intrinsics = ReadArray4(n, "intrinsics");
   c.distortion = ReadArray4(n, "distortion");
   c.T_body_cam = ReadTransform(n, "T_body_cam");
+  c.vignetting_cos4_strength = n.Get<double>("vignetting_cos4_strength", 0.0);
   FailOn(n, c.Problem());
   return c;
 }
@@ -112,6 +113,9 @@ void PutCamera(std::string* out, std::string_view name, const CameraModel& c) {
   b.Put("distortion", c.distortion,
         c.distortion_model == DistortionModel::kEquidistant ? "k1, k2, k3, k4" : "k1, k2, p1, p2");
   b.Put("T_body_cam", c.T_body_cam);
+  if (c.vignetting_cos4_strength != 0.0) {
+    b.Put("vignetting_cos4_strength", c.vignetting_cos4_strength);
+  }
 }
 
 // Prefixes a problem's field with the section it is in.

@@ -160,6 +160,10 @@ std::optional<FieldProblem> CameraModel::Problem() const {
   if (std::optional<std::string> problem = RigidTransformProblem(T_body_cam.matrix())) {
     return FieldProblem{"T_body_cam", *problem};
   }
+  if (!(vignetting_cos4_strength >= 0.0 && vignetting_cos4_strength < 1.0)) {
+    return FieldProblem{"vignetting_cos4_strength", "expected a strength in [0, 1), found " +
+                                                        NumberText(vignetting_cos4_strength)};
+  }
   return std::nullopt;
 }
 
@@ -172,7 +176,8 @@ void CameraModel::Validate() const {
 bool operator==(const CameraModel& a, const CameraModel& b) {
   return a.width_px == b.width_px && a.height_px == b.height_px && a.rate_hz == b.rate_hz &&
          a.distortion_model == b.distortion_model && a.intrinsics == b.intrinsics &&
-         a.distortion == b.distortion && a.T_body_cam.matrix() == b.T_body_cam.matrix();
+         a.distortion == b.distortion && a.T_body_cam.matrix() == b.T_body_cam.matrix() &&
+         a.vignetting_cos4_strength == b.vignetting_cos4_strength;
 }
 
 }  // namespace rover::calib

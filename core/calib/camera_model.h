@@ -47,6 +47,12 @@ struct CameraModel {
   /// k1 k2 p1 p2 (radial-tangential) or k1 k2 k3 k4 (equidistant).
   std::array<double, 4> distortion{};
   Eigen::Isometry3d T_body_cam = Eigen::Isometry3d::Identity();
+  /// Vignetting (the lens darkens the image towards its edges): the relative
+  /// brightness of a pixel whose ray is theta off the optical axis is
+  /// 1 - v (1 - cos^4 theta), v this strength in [0, 1); 0: a flat field.
+  /// Trackers that assume a point keeps its brightness (KLT) are biased by
+  /// it, so the rectifier undoes it.
+  double vignetting_cos4_strength = 0.0;
 
   /// The pixel at which the point `p_cam` (camera frame, metres or any unit)
   /// is seen, or nullopt for a point not in front of the camera (z <= 0 or
@@ -61,7 +67,8 @@ struct CameraModel {
   std::optional<Eigen::Vector3d> Unproject(const Eigen::Vector2d& pixel) const;
 
   /// The first unusable field ("width_px", "height_px", "rate_hz",
-  /// "intrinsics", "distortion", "T_body_cam") and why, or nullopt: sizes
+  /// "intrinsics", "distortion", "T_body_cam", "vignetting_cos4_strength")
+  /// and why, or nullopt: sizes
   /// and rate must be positive, focal lengths positive, every number finite,
   /// T_body_cam a rigid transform (RigidTransformProblem).
   std::optional<FieldProblem> Problem() const;

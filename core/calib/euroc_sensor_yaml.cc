@@ -94,6 +94,10 @@ CameraModel LoadEurocCamera(const std::string& path) {
   std::copy(k.begin(), k.end(), c.intrinsics.begin());
   std::copy(d.begin(), d.end(), c.distortion.begin());
   c.T_body_cam = ReadTbs(fs, path);
+  // Not a EuRoC key: this project's extension (absent: a flat field).
+  if (!fs["vignetting_cos4_strength"].empty()) {
+    c.vignetting_cos4_strength = ReadDouble(fs, path, "vignetting_cos4_strength");
+  }
   return c;
 }
 

@@ -3,7 +3,9 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace rover::calib {
 namespace {
@@ -66,10 +68,15 @@ std::optional<StereoRectifier> StereoRectifier::Create(const CameraModel& cam0,
   if (!(fx > 0.0) || !(baseline > 0.0) || !std::isfinite(baseline)) return std::nullopt;
   out.intrinsics_ = {fx, p0.at<double>(1, 1), p0.at<double>(0, 2), p0.at<double>(1, 2)};
   out.baseline_m_ = baseline;
-  Eigen::Matrix3d R_rect_cam0;
+  Eigen::Matrix3d R_rect_cam0, R_rect_cam1;
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) R_rect_cam0(i, j) = r0.at<double>(i, j);
+    for (int j = 0; j < 3; ++j) {
+      R_rect_cam0(i, j) = r0.at<double>(i, j);
+      R_rect_cam1(i, j) = r1.at<double>(i, j);
+    }
   }
+  out.flat_field_q8_[0] = FlatFieldGainQ8(cam0, R_rect_cam0, out.intrinsics_, out.size_);
+  out.flat_field_q8_[1] = FlatFieldGainQ8(cam1, R_rect_cam1, out.intrinsics_, out.size_);
   Eigen::Isometry3d T_rect_cam0 = Eigen::Isometry3d::Identity();
   T_rect_cam0.linear() = R_rect_cam0;
   out.T_cam0rect_body_ = T_rect_cam0 * cam0.T_body_cam.inverse();
@@ -85,6 +92,27 @@ std::optional<StereoRectifier> StereoRectifier::Create(const CameraModel& cam0,
   return out;
 }
 
+cv::Mat StereoRectifier::FlatFieldGainQ8(const CameraModel& cam, const Eigen::Matrix3d& R_rect_cam,
+                                         const RectifiedIntrinsics& k, cv::Size size) {
+  const double v = cam.vignetting_cos4_strength;
+  if (!(v > 0.0)) return {};
+  cv::Mat gain(size, CV_16UC1);
+  // A rectified pixel's ray, rotated back into the raw camera, gives the
+  // angle theta the lens saw it at (no distortion model needed).
+  const Eigen::Matrix3d R_cam_rect = R_rect_cam.transpose();
+  for (int y = 0; y < size.height; ++y) {
+    uint16_t* row = gain.ptr<uint16_t>(y);
+    for (int x = 0; x < size.width; ++x) {
+      const Eigen::Vector3d ray_cam =
+          R_cam_rect * Eigen::Vector3d((x - k.cx) / k.fx, (y - k.cy) / k.fy, 1.0);
+      const double cos_theta = std::max(0.0, ray_cam.z() / ray_cam.norm());
+      const double brightness = 1.0 - v * (1.0 - std::pow(cos_theta, 4.0));
+      row[x] = static_cast<uint16_t>(std::min(65535.0, std::round(256.0 / brightness)));
+    }
+  }
+  return gain;
+}
+
 bool StereoRectifier::RectifyOne(int index, const cv::Mat& raw, cv::Mat* rect) const {
   if (index < 0 || index > 1 || rect == nullptr || raw.empty() || raw.type() != CV_8UC1 ||
       raw.size() != size_) {
@@ -92,6 +120,16 @@ bool StereoRectifier::RectifyOne(int index, const cv::Mat& raw, cv::Mat* rect) c
   }
   const auto i = static_cast<size_t>(index);
   cv::remap(raw, *rect, map_a_[i], map_b_[i], cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  const cv::Mat& gain = flat_field_q8_[i];
+  if (gain.empty()) return true;
+  for (int y = 0; y < rect->rows; ++y) {
+    uint8_t* pixel = rect->ptr<uint8_t>(y);
+    const uint16_t* g = gain.ptr<uint16_t>(y);
+    for (int x = 0; x < rect->cols; ++x) {
+      const uint32_t value = (static_cast<uint32_t>(pixel[x]) * g[x] + 128u) >> 8;
+      pixel[x] = static_cast<uint8_t>(std::min<uint32_t>(value, 255u));
+    }
+  }
   return true;
 }
 

@@ -50,8 +50,11 @@ class StereoRectifier {
   static std::optional<StereoRectifier> Create(const CameraModel& cam0, const CameraModel& cam1,
                                                const StereoRectifierOptions& options = {});
 
-  /// Remaps a raw 8-bit grey image pair. Returns false (outputs untouched) when
-  /// either image is empty, of the wrong size or not CV_8UC1.
+  /// Remaps a raw 8-bit grey image pair and undoes each camera's vignetting
+  /// (CameraModel::vignetting_cos4_strength; brightened values saturate at
+  /// 255), so that a point keeps its brightness across the image and between
+  /// the two cameras. Returns false (outputs untouched) when either image is
+  /// empty, of the wrong size or not CV_8UC1.
   bool Rectify(const cv::Mat& raw0, const cv::Mat& raw1, cv::Mat* rect0, cv::Mat* rect1) const;
   /// Remaps one raw image of camera `index` (0 or 1); false on bad input.
   bool RectifyOne(int index, const cv::Mat& raw, cv::Mat* rect) const;
@@ -69,10 +72,17 @@ class StereoRectifier {
 
  private:
   StereoRectifier() = default;
+  /// The gain map of one camera (see flat_field_q8_) from its rectifying
+  /// rotation R_rect_cam and the rectified intrinsics.
+  static cv::Mat FlatFieldGainQ8(const CameraModel& cam, const Eigen::Matrix3d& R_rect_cam,
+                                 const RectifiedIntrinsics& k, cv::Size size);
 
   cv::Size size_;
   std::array<cv::Mat, 2> map_a_;
   std::array<cv::Mat, 2> map_b_;
+  /// Per rectified pixel, the gain that undoes the vignetting, 8.8 fixed
+  /// point (CV_16UC1); empty for a flat-field camera.
+  std::array<cv::Mat, 2> flat_field_q8_;
   RectifiedIntrinsics intrinsics_;
   double baseline_m_ = 0.0;
   Eigen::Isometry3d T_cam0rect_body_ = Eigen::Isometry3d::Identity();

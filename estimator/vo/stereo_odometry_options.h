@@ -56,9 +56,9 @@ struct StereoOdometryOptions {
   StereoMatcherOptions stereo;
   TemporalTrackerOptions tracker;
   /// Covariance scale calibrated on simulated drives (the mean NEES of
-  /// short seeds 1 and 3 and loop-100m seed 1 was 1.09 x its 6 dof with
-  /// scale 1), see estimator/vo/README.md.
-  MotionEstimatorOptions motion{.covariance_scale = 1.1};
+  /// short seeds 1 and 3 and loop-100m seed 1 was 0.88 x its 6 dof with
+  /// scale 1, images flat-fielded), see estimator/vo/README.md.
+  MotionEstimatorOptions motion{.covariance_scale = 0.88};
   KeyframeOptions keyframes;
   ImageCheckOptions checks;
   /// Features kept per keyframe (strongest first after bucketing).

@@ -91,6 +91,7 @@ calib::CameraModel CameraOf(const topics::CameraCalibrationMsg& m) {
   c.T_body_cam.linear() = q.normalized().toRotationMatrix();
   c.T_body_cam.translation() =
       Eigen::Vector3d(m.p_body_cam_m[0], m.p_body_cam_m[1], m.p_body_cam_m[2]);
+  c.vignetting_cos4_strength = m.vignetting_cos4_strength;
   return c;
 }
 

@@ -49,6 +49,7 @@ topics::CameraCalibrationMsg ToCameraMsg(const calib::CameraModel& cam) {
   const Eigen::Quaterniond q(cam.T_body_cam.linear());
   m.p_body_cam_m = {p.x(), p.y(), p.z()};
   m.q_body_cam_wxyz = {q.w(), q.x(), q.y(), q.z()};
+  m.vignetting_cos4_strength = cam.vignetting_cos4_strength;
   return m;
 }
 

@@ -5,14 +5,14 @@
 //
 // The filter's covariance at a switch says how well the filter knows its pose
 // in the old frame if its measurement errors were white. They are not: stereo
-// VO carries a scale error that is the same for every frame pair (the
-// disparity bias of the same terrain), and the IMU biases drift slowly, so
-// the errors of one submap's drive add up coherently. In simulation
-// (`rover-sim map` reports it per mission) a 6.8 m switch is off by
-// 0.015-0.017 m along-track while the filter claims 0.0012 m: a mean NEES of
-// about 240 where 4 is consistent. A graph that trusts those covariances is
-// so stiff that the Cauchy loss discounts true loop closures as outliers,
-// and the pairing gate believes revisits cannot be missed.
+// VO carries a small scale error that is the same for every frame pair, and
+// the IMU biases drift slowly, so the errors of one submap's drive add up
+// coherently. In simulation (`rover-sim map` reports it per mission) a 6.6 m
+// switch is off by 0.004 +- 0.004 m along-track (0.015 m before the images
+// were flat-fielded) while the filter claims about 0.001 m. A graph that
+// trusts those covariances is so stiff that the Cauchy loss discounts true
+// loop closures as outliers, and the pairing gate believes revisits cannot
+// be missed.
 //
 // The model keeps the filter's covariance and adds an odometry error that
 // grows with the distance d driven in the frame (the norm of the switch's
@@ -33,10 +33,10 @@ struct FrameSwitchNoiseOptions {
   double filter_sigma_scale = 1.0;
   /// Odometry error per metre driven in the frame, along the displacement
   /// and across it (both horizontal and vertical), in m per m.
-  double along_sigma_per_m = 0.0025;
-  double across_sigma_per_m = 0.0012;
-  /// Yaw error per metre driven, in rad per m (0.015 deg per m).
-  double yaw_sigma_rad_per_m = 2.6e-4;
+  double along_sigma_per_m = 0.0012;
+  double across_sigma_per_m = 0.0006;
+  /// Yaw error per metre driven, in rad per m (0.011 deg per m).
+  double yaw_sigma_rad_per_m = 2.0e-4;
 
   /// Throws std::invalid_argument naming the first key that is negative,
   /// not finite, or (filter_sigma_scale) not positive.

@@ -21,8 +21,8 @@
 //   health: {period_s: 1.0, stale_after_s: 1.0, rate_warn_fraction: 0.9, watchdog: true}
 //   mapd: {submap_max_distance_m: 7.0, submap_max_position_sigma_m: 0.1,
 //          restart_backoff_s: 1.0, mapping: true, mapping_rate_hz: 2.0,
-//          switch_along_sigma_per_m: 0.0025, switch_across_sigma_per_m: 0.0012,
-//          switch_yaw_sigma_rad_per_m: 2.6e-4}
+//          switch_along_sigma_per_m: 0.0012, switch_across_sigma_per_m: 0.0006,
+//          switch_yaw_sigma_rad_per_m: 2.0e-4}
 //
 // Every section except `board` and `log` is optional and every key in an
 // optional section defaults to the value shown. Unknown keys are errors.
@@ -152,9 +152,9 @@ struct BoardMapdOptions {
   /// driven in the frame (mapping::FrameSwitchNoiseOptions): along the
   /// displacement and across it in m per m, yaw in rad per m. Measured
   /// against ground truth (`rover-sim map` reports the switches' NEES).
-  double switch_along_sigma_per_m = 0.0025;
-  double switch_across_sigma_per_m = 0.0012;
-  double switch_yaw_sigma_rad_per_m = 2.6e-4;
+  double switch_along_sigma_per_m = 0.0012;
+  double switch_across_sigma_per_m = 0.0006;
+  double switch_yaw_sigma_rad_per_m = 2.0e-4;
 };
 
 /// The whole board profile.

@@ -26,7 +26,7 @@
 namespace rover::runtime::topics {
 
 /// Bumped whenever a message below changes layout or meaning.
-inline constexpr uint32_t kTopicsVersion = 3;
+inline constexpr uint32_t kTopicsVersion = 4;
 
 inline constexpr std::string_view kPoseTopic = "/roverd/pose";
 inline constexpr std::string_view kStereoFrameTopic = "/roverd/stereo_frame";
@@ -218,6 +218,7 @@ struct CameraCalibrationMsg {
   std::array<double, 4> distortion{};  ///< coefficients of distortion_model
   std::array<double, 3> p_body_cam_m{};
   std::array<double, 4> q_body_cam_wxyz{1.0, 0.0, 0.0, 0.0};
+  double vignetting_cos4_strength = 0.0;  ///< calib::CameraModel's
 };
 
 /// The stereo head's calibration, published once by roverd with history so

@@ -123,7 +123,11 @@ void EurocWriter::WriteCameraCalibration(int index, const calib::CameraModel& c)
       "] #fu, fv, cu, cv\ndistortion_model: " +
       std::string(calib::EurocDistortionName(c.distortion_model)) + "\ndistortion_coefficients: [" +
       Num(c.distortion[0]) + ", " + Num(c.distortion[1]) + ", " + Num(c.distortion[2]) + ", " +
-      Num(c.distortion[3]) + "]\n";
+      Num(c.distortion[3]) + "]\n" +
+      (c.vignetting_cos4_strength != 0.0
+           ? "vignetting_cos4_strength: " + Num(c.vignetting_cos4_strength) +
+                 "  # not EuRoC: brightness 1 - v (1 - cos^4 theta) off axis\n"
+           : std::string());
   WriteText(files_->mav0 / ("cam" + std::to_string(index)) / "sensor.yaml", yaml);
   if (index == 0) {
     WriteText(files_->mav0 / "depth0/sensor.yaml",

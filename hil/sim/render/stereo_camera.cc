@@ -1,5 +1,6 @@
 #include "hil/sim/render/stereo_camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -167,6 +168,8 @@ calib::CameraModel CameraModelOf(const StereoCameraOptions& camera,
   c.intrinsics = {camera.fx_px, camera.fy_px, camera.cx_px, camera.cy_px};
   c.distortion = camera.DistortionCoeffs();
   c.T_body_cam = T_body_cam;
+  // The renderer's cos^4 model is the calibration's.
+  c.vignetting_cos4_strength = std::min(camera.vignetting_strength, 0.99);
   return c;
 }
 

@@ -19,6 +19,7 @@ namespace rover::calib {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // The format's example (EuRoC V1 calibration, with wheels), line numbers as
 // the error tests expect them.
@@ -161,6 +162,8 @@ class RandomCalibration {
     c.intrinsics = {Positive(), Positive(), Any(), Any()};
     c.distortion = {Any(), Any(), Any(), Any()};
     c.T_body_cam = Transform();
+    c.vignetting_cos4_strength =
+        Index(2) == 0 ? 0.0 : static_cast<double>(Index(999983)) / 1000003.0;
     return c;
   }
   BoardCalibration Board() {
@@ -364,6 +367,22 @@ TEST(BoardCalibrationTest, CameraValuesAreChecked) {
             "\"pinhole-equidistant\", found fisheye");
   EXPECT_THAT(LoadError(Edited("[-0.28340811,", "[.nan,")),
               HasSubstr("cal.yaml:16: cameras.cam0.distortion[0]: expected a finite number"));
+  EXPECT_THAT(LoadError(Edited("    rate_hz: 20\n",
+                               "    rate_hz: 20\n    vignetting_cos4_strength: 1.2\n")),
+              HasSubstr("cameras.cam0.vignetting_cos4_strength: expected a strength in [0, 1), "
+                        "found 1.2"));
+}
+
+TEST(BoardCalibrationTest, VignettingIsOptionalAndRoundTrips) {
+  const BoardCalibration flat = BoardCalibration::LoadString(Edited("", ""), "cal.yaml");
+  ASSERT_TRUE(flat.stereo.has_value());
+  EXPECT_EQ(flat.stereo->cam0.vignetting_cos4_strength, 0.0);
+  EXPECT_THAT(flat.ToYaml(), Not(HasSubstr("vignetting")));
+  BoardCalibration c = flat;
+  c.stereo->cam0.vignetting_cos4_strength = 0.45;
+  const std::string yaml = c.ToYaml();
+  EXPECT_THAT(yaml, HasSubstr("    vignetting_cos4_strength: 0.45\n"));
+  ExpectBitIdentical(BoardCalibration::LoadString(yaml, "written.yaml"), c);
 }
 
 TEST(BoardCalibrationTest, ImuAndWheelValuesAreChecked) {

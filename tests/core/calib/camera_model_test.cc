@@ -203,6 +203,11 @@ TEST(CameraModelTest, ValidateNamesTheBadField) {
   c = RadTanCam();
   c.T_body_cam.matrix()(3, 0) = 0.5;
   EXPECT_EQ(ProblemOf(c), "T_body_cam: expected the last row 0 0 0 1, found 0.5 0 0 1");
+  c = RadTanCam();
+  c.vignetting_cos4_strength = 1.0;
+  EXPECT_EQ(ProblemOf(c), "vignetting_cos4_strength: expected a strength in [0, 1), found 1");
+  c.vignetting_cos4_strength = NAN;
+  EXPECT_THAT(ProblemOf(c), HasSubstr("vignetting_cos4_strength: expected a strength"));
 }
 
 TEST(CameraModelTest, EqualityComparesEveryField) {
@@ -216,6 +221,9 @@ TEST(CameraModelTest, EqualityComparesEveryField) {
   EXPECT_NE(a, b);
   b = a;
   b.rate_hz = 30.0;
+  EXPECT_NE(a, b);
+  b = a;
+  b.vignetting_cos4_strength = 0.3;
   EXPECT_NE(a, b);
 }
 

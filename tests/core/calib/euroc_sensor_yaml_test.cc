@@ -95,6 +95,14 @@ TEST(EurocSensorYamlTest, ReadsEquidistantCameras) {
   EXPECT_EQ(c.T_body_cam.translation().x(), 0.05);
 }
 
+TEST(EurocSensorYamlTest, ReadsThisProjectsVignettingExtension) {
+  const testing::TempDir dir("euroc_yaml");
+  EXPECT_EQ(LoadEurocCamera(Write(dir, kCamera)).vignetting_cos4_strength, 0.0);
+  const std::string path =
+      Write(dir, kCamera, "rate_hz: 20", "rate_hz: 20\nvignetting_cos4_strength: 0.5");
+  EXPECT_EQ(LoadEurocCamera(path).vignetting_cos4_strength, 0.5);
+}
+
 TEST(EurocSensorYamlTest, ErrorsNameTheFileAndKey) {
   const testing::TempDir dir("euroc_yaml");
   std::string path = Write(dir, kCamera, "distortion_model: equidistant", "distortion_model: fov");

@@ -107,6 +107,46 @@ TEST(StereoRectifierTest, EquidistantGeometry) {
   ExpectRectifiedGeometry(FisheyeCam(0), FisheyeCam(1));
 }
 
+// A uniformly lit scene seen through a lens that vignettes: the raw image
+// darkens towards its edges as 1 - v (1 - cos^4 theta).
+cv::Mat VignettedFlatScene(const CameraModel& c, double strength, double level) {
+  cv::Mat raw(c.height_px, c.width_px, CV_8UC1);
+  for (int y = 0; y < raw.rows; ++y) {
+    for (int x = 0; x < raw.cols; ++x) {
+      const std::optional<Eigen::Vector3d> ray = c.Unproject(Eigen::Vector2d(x, y));
+      const double cos_theta = ray ? ray->z() / ray->norm() : 0.0;
+      raw.at<uint8_t>(y, x) =
+          cv::saturate_cast<uint8_t>(level * (1.0 - strength * (1.0 - std::pow(cos_theta, 4))));
+    }
+  }
+  return raw;
+}
+
+TEST(StereoRectifierTest, UndoesTheCalibratedVignetting) {
+  constexpr double kStrength = 0.5, kLevel = 160.0;
+  CameraModel c0 = EurocCam(0), c1 = EurocCam(1);
+  const cv::Mat raw0 = VignettedFlatScene(c0, kStrength, kLevel);
+  const cv::Mat raw1 = VignettedFlatScene(c1, kStrength, kLevel);
+  // Without the vignetting in the calibration the corners stay dark.
+  const auto flat = StereoRectifier::Create(c0, c1);
+  ASSERT_TRUE(flat.has_value());
+  cv::Mat rect0, rect1;
+  ASSERT_TRUE(flat->Rectify(raw0, raw1, &rect0, &rect1));
+  EXPECT_LT(rect0.at<uint8_t>(20, 20), kLevel - 20);
+  // With it, the rectified images are flat (the valid region: alpha 0).
+  c0.vignetting_cos4_strength = c1.vignetting_cos4_strength = kStrength;
+  const auto corrected = StereoRectifier::Create(c0, c1);
+  ASSERT_TRUE(corrected.has_value());
+  ASSERT_TRUE(corrected->Rectify(raw0, raw1, &rect0, &rect1));
+  for (const cv::Mat* rect : {&rect0, &rect1}) {
+    for (int y = 10; y < rect->rows - 10; y += 7) {
+      for (int x = 10; x < rect->cols - 10; x += 7) {
+        ASSERT_NEAR(rect->at<uint8_t>(y, x), kLevel, 2.0) << "at x " << x << ", y " << y;
+      }
+    }
+  }
+}
+
 TEST(StereoRectifierTest, RejectsMixedDistortionModels) {
   // OpenCV rectifies a pair of one model only.
   EXPECT_FALSE(StereoRectifier::Create(EurocCam(0), FisheyeCam(1)).has_value());

@@ -123,11 +123,12 @@ TEST(StereoOdometrySimTest, ShortScenarioDriftAndConsistency) {
   EXPECT_GE(fig.measurements, fig.frames - 2);
   EXPECT_LT(fig.final_error_m / fig.distance_m, 0.01);
   EXPECT_LT(fig.final_rotation_error_rad, 1.0 * 3.14159 / 180.0);
-  // One covariance scale serves every scene to about +-10 % (README), while
-  // the 95 % interval of a single 650-measurement run is +-4.5 %: allow the
-  // scene-to-scene part on top of the interval.
-  EXPECT_LT(fig.mean_nees, 1.15 * fig.nees_hi);
-  EXPECT_GT(fig.mean_nees, 0.85 * fig.nees_lo);
+  // One covariance scale serves every scene to about +-15 % (README: this
+  // scene is the most conservative one, NEES about 0.8 of the others'),
+  // while the 95 % interval of a single 650-measurement run is +-4.5 %:
+  // allow the scene-to-scene part on top of the interval.
+  EXPECT_LT(fig.mean_nees, 1.2 * fig.nees_hi);
+  EXPECT_GT(fig.mean_nees, 0.8 * fig.nees_lo);
 }
 
 }  // namespace

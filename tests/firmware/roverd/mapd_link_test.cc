@@ -144,9 +144,9 @@ TEST_F(MapdLinkTest, HandsRequestsToTheLoopStampedAtTheNewestEstimate) {
   EXPECT_EQ(loop.stats().late_inputs, 0u);
 }
 
-// The calibration message carries each camera's lens model, so that mapd
-// rectifies a fisheye head as one.
-TEST(CalibrationMsgTest, CarriesTheDistortionModelAndThePose) {
+// The calibration message carries each camera's lens model and vignetting,
+// so that mapd rectifies (and flat-fields) the pairs as roverd does.
+TEST(CalibrationMsgTest, CarriesTheDistortionModelThePoseAndTheVignetting) {
   calib::CameraModel cam0;
   cam0.width_px = 752;
   cam0.height_px = 480;
@@ -156,6 +156,7 @@ TEST(CalibrationMsgTest, CarriesTheDistortionModelAndThePose) {
   calib::CameraModel cam1 = cam0;
   cam1.distortion_model = calib::DistortionModel::kEquidistant;
   cam1.distortion = {0.0034, 0.0007, -0.0021, 0.0002};
+  cam1.vignetting_cos4_strength = 0.4;
   const topics::StereoCalibrationMsg m = ToCalibrationMsg(cam0, cam1);
   EXPECT_EQ(m.version, topics::kTopicsVersion);
   EXPECT_EQ(m.cam0.distortion_model, topics::kDistortionRadialTangential);
@@ -165,6 +166,8 @@ TEST(CalibrationMsgTest, CarriesTheDistortionModelAndThePose) {
   EXPECT_EQ(m.cam0.intrinsics, cam0.intrinsics);
   EXPECT_EQ(m.cam0.p_body_cam_m[0], 0.1);
   EXPECT_EQ(m.cam0.q_body_cam_wxyz[0], 1.0);
+  EXPECT_EQ(m.cam0.vignetting_cos4_strength, 0.0);
+  EXPECT_EQ(m.cam1.vignetting_cos4_strength, 0.4);
 }
 
 }  // namespace

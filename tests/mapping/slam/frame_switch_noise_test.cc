@@ -27,7 +27,10 @@ TEST(FrameSwitchNoiseTest, WithoutOdometryErrorTheFilterCovarianceIsScaledOnly) 
 }
 
 TEST(FrameSwitchNoiseTest, ErrorGrowsWithDistanceAlongAndAcrossTheDisplacement) {
-  FrameSwitchNoiseOptions o;  // defaults: 0.0025 along, 0.0012 across, 2.6e-4 rad yaw per m
+  FrameSwitchNoiseOptions o;
+  o.along_sigma_per_m = 0.0025;
+  o.across_sigma_per_m = 0.0012;
+  o.yaw_sigma_rad_per_m = 2.6e-4;
   const Eigen::Vector3d p_old_new_m(6.0, 8.0, 0.0);  // 10 m at 53 deg
   const Eigen::Matrix4d added =
       FrameSwitchCovariance(FilterCovariance(), p_old_new_m, o) - FilterCovariance();
