@@ -68,9 +68,9 @@ struct CameraModel {
 
   /// The first unusable field ("width_px", "height_px", "rate_hz",
   /// "intrinsics", "distortion", "T_body_cam", "vignetting_cos4_strength")
-  /// and why, or nullopt: sizes
-  /// and rate must be positive, focal lengths positive, every number finite,
-  /// T_body_cam a rigid transform (RigidTransformProblem).
+  /// and why, or nullopt: sizes and rate must be positive, focal lengths
+  /// positive, every number finite, T_body_cam a rigid transform
+  /// (RigidTransformProblem), the vignetting strength in [0, 1).
   std::optional<FieldProblem> Problem() const;
 
   /// Throws std::invalid_argument "field: expected ..., found ..." if

@@ -1,30 +1,19 @@
 #include "mapping/slam/frame_switch_noise.h"
 
 #include <cmath>
-#include <stdexcept>
-#include <string>
+#include <limits>
+
+#include "mapping/loop/option_checks.h"
 
 namespace rover::mapping {
-namespace {
-
-void RequireNonNegative(double value, const char* key) {
-  if (!std::isfinite(value) || value < 0.0) {
-    throw std::invalid_argument(std::string("frame switch noise: ") + key +
-                                " must be finite and >= 0, got " + std::to_string(value));
-  }
-}
-
-}  // namespace
 
 void FrameSwitchNoiseOptions::Validate() const {
-  if (!std::isfinite(filter_sigma_scale) || filter_sigma_scale <= 0.0) {
-    throw std::invalid_argument(
-        "frame switch noise: filter_sigma_scale must be finite and > 0, got " +
-        std::to_string(filter_sigma_scale));
-  }
-  RequireNonNegative(along_sigma_per_m, "along_sigma_per_m");
-  RequireNonNegative(across_sigma_per_m, "across_sigma_per_m");
-  RequireNonNegative(yaw_sigma_rad_per_m, "yaw_sigma_rad_per_m");
+  constexpr const char* kC = "FrameSwitchNoiseOptions";
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  loop_internal::CheckPositive(kC, "filter_sigma_scale", filter_sigma_scale);
+  loop_internal::CheckRange(kC, "along_sigma_per_m", along_sigma_per_m, 0.0, kInf);
+  loop_internal::CheckRange(kC, "across_sigma_per_m", across_sigma_per_m, 0.0, kInf);
+  loop_internal::CheckRange(kC, "yaw_sigma_rad_per_m", yaw_sigma_rad_per_m, 0.0, kInf);
 }
 
 FrameSwitchNoiseOptions FrameSwitchNoiseOptions::Load(const ConfigNode& node) {

@@ -8,6 +8,7 @@
 
 #include "core/log/mcap/mcap_reader.h"
 #include "core/log/msgs/message_traits.h"
+#include "mapping/graph/rover_graph.h"
 
 namespace rover::mapping {
 namespace {
@@ -81,6 +82,13 @@ Matrix6d RosPoseCovariance(const Eigen::Matrix3d& R_world_body, const Matrix6d& 
   Matrix6d J = Matrix6d::Identity();
   J.bottomRightCorner<3, 3>() = R_world_body;
   return J * covariance * J.transpose();
+}
+
+Eigen::Isometry3d MovedFinalGlobalPose(const GraphLogContents& logged, const RoverGraph& graph) {
+  const log::rover_msgs::SubmapOrigin& newest = logged.last_origins->origins.back();
+  const Eigen::Isometry3d T_local_body =
+      FromPoseMsg(newest.pose).inverse() * FromPoseMsg(logged.last_global_pose->pose.pose);
+  return graph.Origin(newest.robot, newest.submap) * T_local_body;
 }
 
 std::optional<Eigen::Isometry3d> GraphInMap(const log::rover_msgs::SubmapOrigins& graph,

@@ -55,6 +55,12 @@ Matrix6d RosPoseCovariance(const Eigen::Matrix3d& R_world_body, const Matrix6d& 
 std::size_t PlaceAtGraphOrigins(const log::rover_msgs::SubmapOrigins& graph,
                                 std::map<uint32_t, Eigen::Isometry3d>* origins);
 
+/// The logged final global pose of `logged` moved with its frame's origin as
+/// `graph` (the logged graph re-solved, possibly with other factors) places
+/// it: its frame is the newest logged origin. Requires last_origins (not
+/// empty) and last_global_pose.
+Eigen::Isometry3d MovedFinalGlobalPose(const GraphLogContents& logged, const RoverGraph& graph);
+
 /// T_map_graph: the graph's world frame in the map frame of `origins`, by
 /// the anchor frame f0 as above; nullopt if f0 is not in `origins`.
 std::optional<Eigen::Isometry3d> GraphInMap(const log::rover_msgs::SubmapOrigins& graph,

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -62,12 +63,18 @@ class Replay {
     }
   }
 
-  // The result's error against the true origins, when known.
-  std::string TruthError(const mapping::SubmapPair& pair, const mapping::SubmapMatchResult& r) {
+  // T_a_b between the true origins of the pair, when both are known.
+  std::optional<Eigen::Isometry3d> TrueTransform(const mapping::SubmapPair& pair) const {
     const auto a = options_.true_origins.find(pair.a.index);
     const auto b = options_.true_origins.find(pair.b.index);
-    if (a == options_.true_origins.end() || b == options_.true_origins.end()) return "";
-    const Eigen::Isometry3d T_true = a->second.inverse() * b->second;
+    if (a == options_.true_origins.end() || b == options_.true_origins.end()) return std::nullopt;
+    return a->second.inverse() * b->second;
+  }
+
+  // The result's and the prior's error against the truth, for the report.
+  static std::string TruthError(const mapping::SubmapPair& pair,
+                                const mapping::SubmapMatchResult& r,
+                                const Eigen::Isometry3d& T_true) {
     const Eigen::Isometry3d error = T_true.inverse() * r.T_a_b;
     const Eigen::Isometry3d prior_error = T_true.inverse() * pair.prior.T_a_b;
     char text[160];
@@ -75,10 +82,6 @@ class Replay {
                   error.translation().norm(),
                   Eigen::AngleAxisd(error.linear()).angle() * 180.0 / M_PI,
                   prior_error.translation().norm());
-    if (error.translation().norm() <= 0.2 &&
-        Eigen::AngleAxisd(error.linear()).angle() <= M_PI / 180.0) {
-      if (r.accepted) ++result_.matches_valid;
-    }
     return text;
   }
 
@@ -104,14 +107,17 @@ class Replay {
     const mapping::SubmapMatchResult r = matcher_.Match(*a->second, *b->second, pair.prior);
     ++result_.pairs_matched;
     const Eigen::Isometry3d correction = pair.prior.T_a_b.inverse() * r.T_a_b;
+    const std::optional<Eigen::Isometry3d> T_true = TrueTransform(pair);
     char line[320];
     std::snprintf(line, sizeof(line), "    replay: %lld-%lld %s%s, %.2f m from the graph%s\n",
                   static_cast<long long>(pair.a.index), static_cast<long long>(pair.b.index),
                   r.accepted ? "accepted" : "rejected: ", r.rejection.c_str(),
-                  correction.translation().norm(), TruthError(pair, r).c_str());
+                  correction.translation().norm(),
+                  T_true ? TruthError(pair, r, *T_true).c_str() : "");
     report_ << line;
     if (!r.accepted) return;
     ++result_.matches_accepted;
+    if (T_true && IsValidLoopClosure(r.T_a_b, *T_true)) ++result_.matches_valid;
     mapping::GraphFactorRecord c = mapping::SubmapMatchFactor(
         mapping::GraphKey::Origin(pair.a.robot, pair.a.index),
         mapping::GraphKey::Origin(pair.b.robot, pair.b.index), r.T_a_b, r.covariance);
@@ -133,22 +139,25 @@ class Replay {
 
 // The replayed graph's origins, and the logged final pose moved with its
 // frame's origin.
-void FinalEstimates(const mapping::GraphLogContents& logged, mapping::RoverGraph& graph,
+void FinalEstimates(const mapping::GraphLogContents& logged, const mapping::RoverGraph& graph,
                     mapping::GraphLogContents* out) {
   out->last_origins = logged.last_origins;
   for (log::rover_msgs::SubmapOrigin& o : out->last_origins->origins) {
     o.pose = mapping::ToPoseMsg(graph.Origin(o.robot, o.submap));
   }
   if (!logged.last_global_pose) return;
-  const log::rover_msgs::SubmapOrigin& newest = logged.last_origins->origins.back();
-  const Eigen::Isometry3d T_local_body = mapping::FromPoseMsg(newest.pose).inverse() *
-                                         mapping::FromPoseMsg(logged.last_global_pose->pose.pose);
   out->last_global_pose = logged.last_global_pose;
   out->last_global_pose->pose.pose =
-      mapping::ToPoseMsg(graph.Origin(newest.robot, newest.submap) * T_local_body);
+      mapping::ToPoseMsg(mapping::MovedFinalGlobalPose(logged, graph));
 }
 
 }  // namespace
+
+bool IsValidLoopClosure(const Eigen::Isometry3d& T_a_b, const Eigen::Isometry3d& T_a_b_true) {
+  const Eigen::Isometry3d error = T_a_b_true.inverse() * T_a_b;
+  return error.translation().norm() <= kValidLoopClosureTranslationM &&
+         Eigen::AngleAxisd(error.linear()).angle() <= kValidLoopClosureRotationDeg * M_PI / 180.0;
+}
 
 LoopReplayResult ReplayLoopClosing(const mapping::GraphLogContents& logged,
                                    const mapping::SubmapLog& submaps,

@@ -34,6 +34,12 @@ struct LoopReplayOptions {
   std::map<int64_t, Eigen::Isometry3d> true_origins;
 };
 
+/// The definition of a valid loop closure the mission reports use: the
+/// match T_a_b within 0.2 m and 1 deg of the true T_a_b.
+inline constexpr double kValidLoopClosureTranslationM = 0.2;
+inline constexpr double kValidLoopClosureRotationDeg = 1.0;
+bool IsValidLoopClosure(const Eigen::Isometry3d& T_a_b, const Eigen::Isometry3d& T_a_b_true);
+
 /// What the replay found, one line per match in `report`.
 struct LoopReplayResult {
   /// The logged graph's prior and frame switches, the replay's matches

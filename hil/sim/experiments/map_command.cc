@@ -133,9 +133,7 @@ void ScoreLoopClosures(const mapping::GraphLogContents& g,
     const auto a = truth.find(f.a.index);
     const auto b = truth.find(f.b->index);
     if (a == truth.end() || b == truth.end()) continue;
-    const Eigen::Isometry3d error = (a->second.inverse() * b->second).inverse() * f.T_a_b;
-    const double angle_rad = Eigen::AngleAxisd(error.linear()).angle();
-    if (error.translation().norm() <= 0.2 && angle_rad <= M_PI / 180.0) ++r->loop_closures_valid;
+    if (IsValidLoopClosure(f.T_a_b, a->second.inverse() * b->second)) ++r->loop_closures_valid;
   }
   r->loop_closure_precision = r->loop_closures > 0 ? static_cast<double>(r->loop_closures_valid) /
                                                          static_cast<double>(r->loop_closures)
@@ -199,10 +197,7 @@ Eigen::Vector3d ResolvedFinalPosition(const mapping::GraphLogContents& g,
   }
   for (const mapping::GraphFactorRecord& f : extra) mapping::AddToGraph(f, &graph);
   graph.Optimize();
-  const log::rover_msgs::SubmapOrigin& newest = g.last_origins->origins.back();
-  const Eigen::Isometry3d T_world_body = mapping::FromPoseMsg(g.last_global_pose->pose.pose);
-  const Eigen::Isometry3d T_local_body = mapping::FromPoseMsg(newest.pose).inverse() * T_world_body;
-  return (graph.Origin(newest.robot, newest.submap) * T_local_body).translation();
+  return mapping::MovedFinalGlobalPose(g, graph).translation();
 }
 
 // Re-solves the logged graph as it is and with false matches added, and
