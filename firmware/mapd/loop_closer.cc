@@ -241,6 +241,7 @@ void LoopCloser::RunMatching() {
       m.T_a_b = r.T_a_b;
       m.covariance = r.covariance;
       m.inliers = static_cast<int>(r.inliers.size());
+      m.from_prior = r.from_prior;
       m.rmse_m = r.icp.rmse_m;
     } catch (const std::exception& e) {
       m.rejection = std::string("matcher failed: ") + e.what();

@@ -84,6 +84,8 @@ struct LoopMatch {
   Eigen::Isometry3d T_a_b = Eigen::Isometry3d::Identity();
   mapping::Matrix6d covariance = mapping::Matrix6d::Identity();
   int inliers = 0;
+  /// No keypoint hypothesis: the ICP started from the tight prior.
+  bool from_prior = false;
   double rmse_m = 0.0;
   double match_ms = 0.0;
 };

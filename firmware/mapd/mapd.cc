@@ -630,13 +630,15 @@ void Mapd::TakeLoopMatches() {
     // How far the match moves b against the graph's estimate: the size of
     // the correction this loop closure brings.
     const Eigen::Isometry3d correction = m.prior.T_a_b.inverse() * m.T_a_b;
-    std::fprintf(stderr,
-                 "mapd: loop closure between submaps %lld and %lld: %.2f m and %.2f deg from the "
-                 "graph's estimate, %d inliers, RMSE %.3f m, %.0f ms\n",
-                 static_cast<long long>(m.a.index), static_cast<long long>(m.b.index),
-                 correction.translation().norm(),
-                 Eigen::AngleAxisd(correction.linear()).angle() * 180.0 / M_PI, m.inliers, m.rmse_m,
-                 m.match_ms);
+    std::fprintf(
+        stderr,
+        "mapd: loop closure between submaps %lld and %lld: %.2f m and %.2f deg from the "
+        "graph's estimate, %s, RMSE %.3f m, %.0f ms\n",
+        static_cast<long long>(m.a.index), static_cast<long long>(m.b.index),
+        correction.translation().norm(),
+        Eigen::AngleAxisd(correction.linear()).angle() * 180.0 / M_PI,
+        m.from_prior ? "aligned from the prior" : (std::to_string(m.inliers) + " inliers").c_str(),
+        m.rmse_m, m.match_ms);
     mapping::GraphFactorRecord factor = mapping::SubmapMatchFactor(
         mapping::GraphKey::Origin(m.a.robot, m.a.index),
         mapping::GraphKey::Origin(m.b.robot, m.b.index), m.T_a_b, m.covariance);

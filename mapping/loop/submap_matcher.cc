@@ -349,6 +349,10 @@ void SubmapMatcherOptions::Validate() const {
   CheckPositive(kC, "prior_sigma_factor", prior_sigma_factor);
   CheckRange(kC, "min_bound_m", min_bound_m, 0.0, 1e6);
   CheckRange(kC, "min_bound_yaw_rad", min_bound_yaw_rad, 0.0, M_PI);
+  CheckRange(kC, "prior_icp_max_sigma_m", prior_icp_max_sigma_m, 0.0, 10.0);
+  CheckRange(kC, "prior_icp_max_sigma_yaw_rad", prior_icp_max_sigma_yaw_rad, 0.0, M_PI);
+  CheckRange(kC, "prior_icp_min_overlap_ratio", prior_icp_min_overlap_ratio, 0.0, 1.0);
+  CheckRange(kC, "prior_icp_min_obstacle_agreement", prior_icp_min_obstacle_agreement, 0.0, 1.0);
   icp.Validate();
   CheckRange(kC, "icp_passes", icp_passes, 1, 10);
   CheckRange(kC, "min_inliers", min_inliers, 2, 1e6);
@@ -392,6 +396,10 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
   d("prior_sigma_factor", &o.prior_sigma_factor);
   d("min_bound_m", &o.min_bound_m);
   d("min_bound_yaw_rad", &o.min_bound_yaw_rad);
+  d("prior_icp_max_sigma_m", &o.prior_icp_max_sigma_m);
+  d("prior_icp_max_sigma_yaw_rad", &o.prior_icp_max_sigma_yaw_rad);
+  d("prior_icp_min_overlap_ratio", &o.prior_icp_min_overlap_ratio);
+  d("prior_icp_min_obstacle_agreement", &o.prior_icp_min_obstacle_agreement);
   if (node.Has("icp")) {
     const ConfigNode icp = node.Child("icp");
     o.icp.metric = icp.GetEnum<IcpMetric>("metric",
@@ -433,34 +441,21 @@ SubmapMatcher::SubmapMatcher(const SubmapMatcherOptions& options) : options_(opt
   options_.Validate();
 }
 
-SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMatchData& b,
-                                       const MatchPrior& prior) const {
-  const SubmapMatcherOptions& o = options_;
-  CheckPriorFinite(prior);
-  SubmapMatchResult r;
-  const Clock::time_point t0 = Clock::now();
-  const auto finish = [&](std::string rejection) {
-    r.rejection = std::move(rejection);
-    r.accepted = r.rejection.empty();
-    r.timings.total_ms = MsSince(t0);
-    return r;
-  };
-  if (!a.suitable()) return finish("submap a unsuitable: " + a.suitability_reason());
-  if (!b.suitable()) return finish("submap b unsuitable: " + b.suitability_reason());
-  if (a.descriptors().descriptors().cols() != b.descriptors().descriptors().cols()) {
-    throw std::invalid_argument("SubmapMatcher::Match: descriptor lengths differ (a: " +
-                                std::to_string(a.descriptors().descriptors().cols()) +
-                                ", b: " + std::to_string(b.descriptors().descriptors().cols()) +
-                                "); build both with the same descriptor options");
-  }
+namespace {
 
+// Steps 1-3: correspondences, Hough clusters, RANSAC. Empty when a hypothesis
+// (r->T_a_b_initial) was found, else why not.
+std::string FindHypothesis(const SubmapMatcherOptions& o, const SubmapMatchData& a,
+                           const SubmapMatchData& b, const MatchPrior& prior,
+                           const PriorBounds& bounds, SubmapMatchResult* result) {
+  SubmapMatchResult& r = *result;
   // 1. Correspondences.
   Clock::time_point ts = Clock::now();
   r.correspondences = FindCorrespondences(a, b, o);
   r.timings.correspondences_ms = MsSince(ts);
   const int n_matches = static_cast<int>(r.correspondences.size());
   if (n_matches < o.min_inliers) {
-    return finish("correspondences " + Describe(n_matches, "<", o.min_inliers));
+    return "correspondences " + Describe(n_matches, "<", o.min_inliers);
   }
 
   // 2. Hough voting both ways.
@@ -469,13 +464,13 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   for (auto& c : HoughClusters(r.correspondences, b, a, false, o)) clusters.push_back(std::move(c));
   r.clusters = static_cast<int>(clusters.size());
   r.timings.hough_ms = MsSince(ts);
-  if (clusters.empty())
-    return finish("no Hough cluster with >= " + std::to_string(o.min_cluster_votes) + " votes");
+  if (clusters.empty()) {
+    return "no Hough cluster with >= " + std::to_string(o.min_cluster_votes) + " votes";
+  }
 
   // 3. RANSAC per cluster; the best by inliers among those spread beyond a
   // line on both sides.
   ts = Clock::now();
-  const PriorBounds bounds(prior, o);
   std::mt19937_64 rng(o.seed);
   Hypothesis best;
   Hypothesis best_on_a_line;
@@ -497,28 +492,39 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
     // Without bounds nothing stops the ICP sliding along the line: its
     // s^2 H^-1 does not show that freedom (a wall on flat ground: 2 mm).
     if (!o.line_hypotheses_need_icp || !prior.bounded) {
-      return finish("inlier keypoints of every hypothesis along a line");
+      return "inlier keypoints of every hypothesis along a line";
     }
     best = std::move(best_on_a_line);
     r.inliers_on_a_line = true;
   }
   if (best.inliers == 0) {
-    return finish(r.hypotheses == 0 ? "no RANSAC hypothesis within the prior's bounds"
-                                    : "no RANSAC hypothesis with inliers");
+    return r.hypotheses == 0 ? "no RANSAC hypothesis within the prior's bounds"
+                             : "no RANSAC hypothesis with inliers";
   }
   r.T_a_b_initial = best.T_a_b;
   for (std::size_t c : best.inlier_matches) r.inliers.push_back(r.correspondences[c]);
   r.inlier_ratio = static_cast<double>(best.inlier_matches.size()) / n_matches;
   if (best.inliers < o.min_inliers) {
-    return finish("RANSAC inliers " + Describe(best.inliers, "<", o.min_inliers));
+    r.inliers_on_a_line = false;
+    return "RANSAC inliers " + Describe(best.inliers, "<", o.min_inliers);
   }
   if (r.inlier_ratio < o.min_inlier_ratio) {
-    return finish("inlier ratio " + Describe(r.inlier_ratio, "<", o.min_inlier_ratio));
+    r.inliers_on_a_line = false;
+    return "inlier ratio " + Describe(r.inlier_ratio, "<", o.min_inlier_ratio);
   }
+  return {};
+}
 
+// Steps 4-5: ICP from r->T_a_b_initial, then the validity checks. Empty when
+// the match is accepted, else the first check that failed.
+std::string RefineAndCheck(const SubmapMatcherOptions& o, const SubmapMatchData& a,
+                           const SubmapMatchData& b, const PriorBounds& bounds,
+                           SubmapMatchResult* result) {
+  SubmapMatchResult& r = *result;
   // 4. ICP.
-  ts = Clock::now();
-  r.icp = AlignSubmaps(a, b, best.T_a_b, o.mode == MatchMode::kFourDof, o.icp);
+  const Clock::time_point ts = Clock::now();
+  const Eigen::Isometry3d start = r.T_a_b_initial;
+  r.icp = AlignSubmaps(a, b, start, o.mode == MatchMode::kFourDof, o.icp);
   // Restarting from its own result (the correspondence distance and the
   // Cauchy scale anneal again) lets the ICP leave a shallow minimum that
   // the coarse RANSAC start led it into.
@@ -530,64 +536,116 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
   r.timings.icp_ms = MsSince(ts);
   r.T_a_b = r.icp.T_a_b;
   if (!r.icp.ok) {
-    return finish("ICP failed (" + std::to_string(r.icp.correspondences) +
-                  " correspondences or a degenerate Hessian)");
+    return "ICP failed (" + std::to_string(r.icp.correspondences) +
+           " correspondences or a degenerate Hessian)";
   }
   const std::size_t smaller = std::min(a.icp_points().size(), b.icp_points().size());
   r.overlap_ratio = std::min(1.0, static_cast<double>(r.icp.overlap_points) /
                                       static_cast<double>(std::max<std::size_t>(1, smaller)));
 
   // 5. Validity.
-  const double shift = (r.icp.T_a_b.translation() - best.T_a_b.translation()).norm();
+  const double shift = (r.icp.T_a_b.translation() - start.translation()).norm();
   if (shift > o.max_icp_shift_m) {
-    return finish("ICP moved " + Describe(shift, ">", o.max_icp_shift_m) + " m");
+    return "ICP moved " + Describe(shift, ">", o.max_icp_shift_m) + " m";
   }
-  const double turn = LogSO3(best.T_a_b.linear().transpose() * r.icp.T_a_b.linear()).norm();
+  const double turn = LogSO3(start.linear().transpose() * r.icp.T_a_b.linear()).norm();
   if (turn > o.max_icp_turn_rad) {
-    return finish("ICP turned " + Describe(turn, ">", o.max_icp_turn_rad) + " rad");
+    return "ICP turned " + Describe(turn, ">", o.max_icp_turn_rad) + " rad";
   }
   if (r.icp.rmse_m > o.max_icp_rmse_m) {
-    return finish("ICP RMSE " + Describe(r.icp.rmse_m, ">", o.max_icp_rmse_m) + " m");
+    return "ICP RMSE " + Describe(r.icp.rmse_m, ">", o.max_icp_rmse_m) + " m";
   }
-  if (r.overlap_ratio < o.min_overlap_ratio) {
-    return finish("overlap " + Describe(r.overlap_ratio, "<", o.min_overlap_ratio));
+  const double min_overlap = r.from_prior ? o.prior_icp_min_overlap_ratio : o.min_overlap_ratio;
+  if (r.overlap_ratio < min_overlap) {
+    return "overlap " + Describe(r.overlap_ratio, "<", min_overlap);
   }
   r.obstacle_agreement =
       r.icp.obstacle_points_near > 0
           ? static_cast<double>(r.icp.obstacle_points_agreeing) / r.icp.obstacle_points_near
           : 0.0;
   if (r.icp.obstacle_points_near < o.min_obstacle_points_near) {
-    return finish("obstacle points near a " +
-                  Describe(r.icp.obstacle_points_near, "<", o.min_obstacle_points_near));
+    return "obstacle points near a " +
+           Describe(r.icp.obstacle_points_near, "<", o.min_obstacle_points_near);
   }
-  if (r.obstacle_agreement < o.min_obstacle_agreement) {
-    return finish("obstacle agreement " +
-                  Describe(r.obstacle_agreement, "<", o.min_obstacle_agreement));
+  const double min_agreement =
+      r.from_prior ? o.prior_icp_min_obstacle_agreement : o.min_obstacle_agreement;
+  if (r.obstacle_agreement < min_agreement) {
+    return "obstacle agreement " + Describe(r.obstacle_agreement, "<", min_agreement);
   }
-  if (r.inliers_on_a_line) {
+  if (r.inliers_on_a_line || r.from_prior) {
     // The keypoints leave the match free along their line (or in yaw about
-    // it): the whole cloud, ground relief included, has to fix it.
+    // it), or there are no keypoints at all: the whole cloud, ground relief
+    // included, has to fix it.
     const double sigma_m = std::sqrt(std::max(r.icp.covariance(0, 0), r.icp.covariance(1, 1)));
     const double sigma_yaw = std::sqrt(r.icp.covariance(5, 5));
+    const char* why = r.from_prior ? "aligned from the prior" : "inlier keypoints along a line";
     if (sigma_m > o.max_line_icp_sigma_m) {
-      return finish("inlier keypoints along a line and the ICP's xy sigma " +
-                    Describe(sigma_m, ">", o.max_line_icp_sigma_m) + " m");
+      return std::string(why) + " and the ICP's xy sigma " +
+             Describe(sigma_m, ">", o.max_line_icp_sigma_m) + " m";
     }
     if (sigma_yaw > o.max_line_icp_sigma_yaw_rad) {
-      return finish("inlier keypoints along a line and the ICP's yaw sigma " +
-                    Describe(sigma_yaw, ">", o.max_line_icp_sigma_yaw_rad) + " rad");
+      return std::string(why) + " and the ICP's yaw sigma " +
+             Describe(sigma_yaw, ">", o.max_line_icp_sigma_yaw_rad) + " rad";
     }
   }
   const std::string outside = bounds.Violation(r.T_a_b);
-  if (!outside.empty()) return finish("final transform outside the prior's bounds: " + outside);
+  if (!outside.empty()) return "final transform outside the prior's bounds: " + outside;
   if (o.mode == MatchMode::kSixDof) {
     const double tilt = TiltOf(r.T_a_b.linear());
     if (tilt > o.max_final_tilt_rad) {
-      return finish("tilt " + Describe(tilt, ">", o.max_final_tilt_rad) + " rad");
+      return "tilt " + Describe(tilt, ">", o.max_final_tilt_rad) + " rad";
     }
   }
   r.covariance = MatchCovariance(r.icp, o);
-  return finish({});
+  return {};
+}
+
+// The prior is tight enough for an ICP started from it to converge to the
+// right basin: x, y within prior_icp_max_sigma_m, yaw within
+// prior_icp_max_sigma_yaw_rad (standard deviations, frame a).
+bool PriorAllowsLocalIcp(const MatchPrior& prior, const SubmapMatcherOptions& o) {
+  if (!prior.bounded || o.prior_icp_max_sigma_m <= 0.0) return false;
+  const double sigma_xy = std::sqrt(std::max(prior.covariance(0, 0), prior.covariance(1, 1)));
+  return sigma_xy <= o.prior_icp_max_sigma_m &&
+         std::sqrt(prior.covariance(5, 5)) <= o.prior_icp_max_sigma_yaw_rad;
+}
+
+}  // namespace
+
+SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMatchData& b,
+                                       const MatchPrior& prior) const {
+  const SubmapMatcherOptions& o = options_;
+  CheckPriorFinite(prior);
+  SubmapMatchResult r;
+  const Clock::time_point t0 = Clock::now();
+  const auto finish = [&](std::string rejection) {
+    r.rejection = std::move(rejection);
+    r.accepted = r.rejection.empty();
+    r.timings.total_ms = MsSince(t0);
+    return r;
+  };
+  if (!a.suitable()) return finish("submap a unsuitable: " + a.suitability_reason());
+  if (!b.suitable()) return finish("submap b unsuitable: " + b.suitability_reason());
+  if (a.descriptors().descriptors().cols() != b.descriptors().descriptors().cols()) {
+    throw std::invalid_argument("SubmapMatcher::Match: descriptor lengths differ (a: " +
+                                std::to_string(a.descriptors().descriptors().cols()) +
+                                ", b: " + std::to_string(b.descriptors().descriptors().cols()) +
+                                "); build both with the same descriptor options");
+  }
+  const PriorBounds bounds(prior, o);
+  std::string no_hypothesis = FindHypothesis(o, a, b, prior, bounds, &r);
+  if (!no_hypothesis.empty()) {
+    if (!PriorAllowsLocalIcp(prior, o)) return finish(std::move(no_hypothesis));
+    // The graph already knows the pair to within the ICP's basin: align the
+    // clouds from the prior (the keypoints failed, e.g. the two submaps saw
+    // the rocks from opposite sides), under stricter checks below.
+    r.from_prior = true;
+    r.T_a_b_initial = prior.T_a_b;
+    const std::string rejection = RefineAndCheck(o, a, b, bounds, &r);
+    return finish(rejection.empty() ? rejection
+                                    : no_hypothesis + "; aligned from the prior: " + rejection);
+  }
+  return finish(RefineAndCheck(o, a, b, bounds, &r));
 }
 
 }  // namespace rover::mapping

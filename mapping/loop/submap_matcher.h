@@ -20,6 +20,8 @@
 //      inlier keypoints lie along a line (line_spread.h) is dropped. The
 //      best one by inliers wins.
 //   4. ICP on the full clouds (submap_icp.h), 4D or 6D.
+//   3b. With no hypothesis and a tight prior, the ICP starts from the prior
+//      (stricter checks; see prior_icp_max_sigma_m).
 //   5. Validity: RANSAC inliers and inlier ratio, ICP residual, overlap,
 //      obstacle agreement (b's obstacles must land on a's obstacles, not on
 //      a's ground: flat ground aligns anywhere, rocks do not), the final
@@ -104,6 +106,17 @@ struct SubmapMatcherOptions {
   double prior_sigma_factor = 3.0;
   double min_bound_m = 0.3;
   double min_bound_yaw_rad = 3.0 * M_PI / 180.0;
+  /// When the keypoints give no hypothesis but the prior is tight (x and y
+  /// standard deviations at most prior_icp_max_sigma_m, yaw at most
+  /// prior_icp_max_sigma_yaw_rad), the ICP starts from the prior: two
+  /// submaps that saw the same rocks from opposite sides share few
+  /// descriptors, yet their clouds overlap. Such a match must pass the
+  /// stricter overlap and obstacle agreement below and the conditioning test
+  /// of line hypotheses (max_line_icp_sigma_*). 0 turns it off.
+  double prior_icp_max_sigma_m = 0.2;
+  double prior_icp_max_sigma_yaw_rad = 1.0 * M_PI / 180.0;
+  double prior_icp_min_overlap_ratio = 0.5;
+  double prior_icp_min_obstacle_agreement = 0.45;
   /// Refinement, run icp_passes times, each from the previous result.
   SubmapIcpOptions icp;
   int icp_passes = 2;
@@ -179,6 +192,9 @@ struct SubmapMatchResult {
   /// The winner's inlier keypoints lie along a line (then the ICP's
   /// conditioning decided).
   bool inliers_on_a_line = false;
+  /// No keypoint hypothesis: the ICP started from the prior
+  /// (SubmapMatcherOptions::prior_icp_max_sigma_m).
+  bool from_prior = false;
   double inlier_ratio = 0.0;  ///< inliers / correspondences of the winning cluster
   /// The RANSAC winner before refinement.
   Eigen::Isometry3d T_a_b_initial = Eigen::Isometry3d::Identity();

@@ -77,11 +77,14 @@ class Replay {
                                 const Eigen::Isometry3d& T_true) {
     const Eigen::Isometry3d error = T_true.inverse() * r.T_a_b;
     const Eigen::Isometry3d prior_error = T_true.inverse() * pair.prior.T_a_b;
-    char text[160];
-    std::snprintf(text, sizeof(text), " (vs truth: %.3f m %.2f deg; prior %.3f m)",
-                  error.translation().norm(),
-                  Eigen::AngleAxisd(error.linear()).angle() * 180.0 / M_PI,
-                  prior_error.translation().norm());
+    const double prior_sigma_xy_m =
+        std::sqrt(std::max(pair.prior.covariance(0, 0), pair.prior.covariance(1, 1)));
+    const double prior_sigma_yaw_deg = std::sqrt(pair.prior.covariance(5, 5)) * 180.0 / M_PI;
+    char text[200];
+    std::snprintf(
+        text, sizeof(text), " (vs truth: %.3f m %.2f deg; prior %.3f m off, sigma %.3f m %.2f deg)",
+        error.translation().norm(), Eigen::AngleAxisd(error.linear()).angle() * 180.0 / M_PI,
+        prior_error.translation().norm(), prior_sigma_xy_m, prior_sigma_yaw_deg);
     return text;
   }
 
@@ -108,12 +111,15 @@ class Replay {
     ++result_.pairs_matched;
     const Eigen::Isometry3d correction = pair.prior.T_a_b.inverse() * r.T_a_b;
     const std::optional<Eigen::Isometry3d> T_true = TrueTransform(pair);
-    char line[320];
-    std::snprintf(line, sizeof(line), "    replay: %lld-%lld %s%s, %.2f m from the graph%s\n",
-                  static_cast<long long>(pair.a.index), static_cast<long long>(pair.b.index),
-                  r.accepted ? "accepted" : "rejected: ", r.rejection.c_str(),
-                  correction.translation().norm(),
-                  T_true ? TruthError(pair, r, *T_true).c_str() : "");
+    char line[640];
+    std::snprintf(
+        line, sizeof(line),
+        "    replay: %lld-%lld %s%s, %.2f m from the graph, overlap %.2f, obstacle "
+        "agreement %.2f%s\n",
+        static_cast<long long>(pair.a.index), static_cast<long long>(pair.b.index),
+        r.accepted ? (r.from_prior ? "accepted from the prior" : "accepted") : "rejected: ",
+        r.rejection.c_str(), correction.translation().norm(), r.overlap_ratio, r.obstacle_agreement,
+        T_true ? TruthError(pair, r, *T_true).c_str() : "");
     report_ << line;
     if (!r.accepted) return;
     ++result_.matches_accepted;

@@ -232,6 +232,34 @@ void ScoreFalseMatches(const mapping::GraphLogContents& g, const Eigen::Isometry
          << " % of all matches): " << Num(r->false_match_error_pct, 4) << " %\n";
 }
 
+// Each optimised origin's error against its true origin, both taken relative
+// to the graph's first origin: where along the mission the graph's error
+// grows (every 5th origin and the last).
+void ReportOriginErrors(const mapping::GraphLogContents& g,
+                        const std::map<int64_t, Eigen::Isometry3d>& truth, std::ostream& report) {
+  if (!g.last_origins || g.last_origins->origins.empty()) return;
+  std::map<int64_t, Eigen::Isometry3d> estimate;
+  for (const log::rover_msgs::SubmapOrigin& o : g.last_origins->origins) {
+    estimate[o.submap] = mapping::FromPoseMsg(o.pose);
+  }
+  const auto first = estimate.begin();
+  const auto first_true = truth.find(first->first);
+  if (first_true == truth.end()) return;
+  report << "  origins vs truth (relative to origin " << first->first << "): submap m deg";
+  const int64_t last = estimate.rbegin()->first;
+  for (const auto& [frame, T_graph_origin] : estimate) {
+    if (frame % 5 != 0 && frame != last) continue;
+    const auto t = truth.find(frame);
+    if (t == truth.end()) continue;
+    const Eigen::Isometry3d est = first->second.inverse() * T_graph_origin;
+    const Eigen::Isometry3d tru = first_true->second.inverse() * t->second;
+    const Eigen::Isometry3d err = tru.inverse() * est;
+    report << " | " << frame << " " << Num(err.translation().norm(), 3) << " "
+           << Num(std::atan2(err.linear()(1, 0), err.linear()(0, 0)) * 180.0 / M_PI, 2);
+  }
+  report << "\n";
+}
+
 // The submaps at the pose graph's optimised origins (mapping::
 // PlaceAtGraphOrigins), and the graph's final global pose against the truth.
 // A restarted mapd's log holds the whole graph again; later logs win.
@@ -258,6 +286,7 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
         TrueOrigins(g, trajectory, mission, T_world_local0);
     ScoreLoopClosures(g, truth, r);
     ReportFrameSwitchConsistency(g, truth, r, report);
+    ReportOriginErrors(g, truth, report);
     if (options.true_origins) {
       // Diagnostic: what the submaps alone are worth, with no origin error.
       for (const auto& [frame, T_world_origin] : truth) {

@@ -199,6 +199,81 @@ TEST_F(SubmapMatcherTest, KeypointsAlongALineAreNotAcceptedWhenTheCloudSlides) {
   }
 }
 
+// A prior as tight as after a short drive: off the truth by (0.08, -0.05)
+// m and 0.3 deg, sigma 0.08 m and 0.4 deg.
+MatchPrior TightPriorNear(const Isometry3d& truth) {
+  MatchPrior p;
+  p.T_a_b = truth * GravityAlignedTransform({0.08, -0.05, 0.02}, 0.3 * kDeg);
+  p.covariance = Matrix6d::Zero();
+  p.covariance.diagonal() << 0.0064, 0.0064, 0.0064, 1e-4, 1e-4, std::pow(0.4 * kDeg, 2);
+  return p;
+}
+
+// Options under which no descriptor corresponds (as between two submaps that
+// saw the rocks from opposite sides): only the prior can start the ICP.
+SubmapMatcherOptions WithoutKeypointMatches() {
+  SubmapMatcherOptions o;
+  o.max_descriptor_distance = 1e-9;
+  return o;
+}
+
+TEST_F(SubmapMatcherTest, ATightPriorStartsTheIcpWhenTheKeypointsFail) {
+  const Isometry3d truth = Truth(0, 1);
+  const SubmapMatchResult r = SubmapMatcher(WithoutKeypointMatches())
+                                  .Match(*Drive(0).data, *Drive(1).data, TightPriorNear(truth));
+  ASSERT_TRUE(r.accepted) << r.rejection;
+  EXPECT_TRUE(r.from_prior);
+  EXPECT_TRUE(r.correspondences.empty());
+  const PoseError e = ErrorOf(r.T_a_b, truth);
+  std::printf(
+      "from the prior: error %.3f m %.2f deg, overlap %.2f, agreement %.2f of %d, rmse %.3f m\n",
+      e.translation_m, e.rotation_rad / kDeg, r.overlap_ratio, r.obstacle_agreement,
+      r.icp.obstacle_points_near, r.icp.rmse_m);
+  // The match targets: within 0.1 m and 0.5 deg (the prior is 0.1 m off).
+  EXPECT_LT(e.translation_m, 0.1);
+  EXPECT_LT(e.rotation_rad, 0.5 * kDeg);
+  EXPECT_GE(r.overlap_ratio, SubmapMatcherOptions{}.prior_icp_min_overlap_ratio);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix6d>(r.covariance).eigenvalues().minCoeff(), 0.0);
+}
+
+TEST_F(SubmapMatcherTest, ALoosePriorOrTheOptionOffKeepsTheKeypointRejection) {
+  const Isometry3d truth = Truth(0, 1);
+  // The thesis's prior of a long drive (sigma 0.5 m): too loose for an ICP
+  // from the prior.
+  SubmapMatchResult r = SubmapMatcher(WithoutKeypointMatches())
+                            .Match(*Drive(0).data, *Drive(1).data, PriorNear(truth));
+  EXPECT_FALSE(r.accepted);
+  EXPECT_FALSE(r.from_prior);
+  EXPECT_EQ(r.rejection.find("correspondences"), 0u) << r.rejection;
+  // Turned off.
+  SubmapMatcherOptions off = WithoutKeypointMatches();
+  off.prior_icp_max_sigma_m = 0.0;
+  r = SubmapMatcher(off).Match(*Drive(0).data, *Drive(1).data, TightPriorNear(truth));
+  EXPECT_FALSE(r.accepted);
+  EXPECT_FALSE(r.from_prior);
+  // Without bounds there is no prior to start from.
+  r = SubmapMatcher(WithoutKeypointMatches())
+          .Match(*Drive(0).data, *Drive(1).data, MatchPrior::Unbounded(truth));
+  EXPECT_FALSE(r.accepted);
+  EXPECT_FALSE(r.from_prior);
+}
+
+// An ICP from the prior may only confirm the prior within its bounds: a
+// confident prior 0.6 m off the truth (sigma 0.08 m, so bounds of 0.3 m)
+// lets the ICP find the true alignment, which lies outside them, and the
+// pair is refused rather than followed.
+TEST_F(SubmapMatcherTest, AnIcpFromThePriorCannotLeaveItsBounds) {
+  const Isometry3d truth = Truth(0, 1);
+  MatchPrior prior = TightPriorNear(truth);
+  prior.T_a_b = truth * GravityAlignedTransform({0.6, 0.0, 0.0}, 0.0);
+  const SubmapMatchResult r =
+      SubmapMatcher(WithoutKeypointMatches()).Match(*Drive(0).data, *Drive(1).data, prior);
+  EXPECT_FALSE(r.accepted) << "error " << ErrorOf(r.T_a_b, truth).translation_m << " m";
+  EXPECT_TRUE(r.from_prior);
+  EXPECT_NE(r.rejection.find("aligned from the prior: "), std::string::npos) << r.rejection;
+  std::printf("prior 0.6 m off: %s\n", r.rejection.c_str());
+}
+
 TEST_F(SubmapMatcherTest, NonFiniteInputIsAClearError) {
   PointCloud cloud = Drive(0).submap.submap->cloud();
   cloud[5].p_submap_m.y() = NAN;
