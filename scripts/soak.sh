@@ -61,9 +61,9 @@ ROVER_SCENARIO_DIR="$OUT/scenarios" "$BIN/hil/sim/mission/rover-launch" \
   --sim figure-eight-soak --seed "$SEED" --out "$OUT" > "$RUN_LOG" 2>&1 &
 LAUNCH=$!
 
-rss_kb() {  # RSS of the newest process named $1 that is a descendant of this run
-  local pid
-  pid=$(pgrep -n -f "$1" || true)
+rss_kb() {  # RSS of the newest process whose name is exactly $1 (not a compiler
+  local pid  # building a file of the same name)
+  pid=$(pgrep -n -x "$1" || true)
   [[ -n "$pid" ]] && awk '/^VmRSS:/ { print $2 }' "/proc/$pid/status" 2>/dev/null || echo 0
 }
 
@@ -72,8 +72,8 @@ START=$(date +%s)
 while kill -0 "$LAUNCH" 2>/dev/null; do
   sleep "$PERIOD_S"
   now=$(( $(date +%s) - START ))
-  r=$(rss_kb "roverd-sim --ipc")
-  m=$(rss_kb "firmware/mapd/mapd")
+  r=$(rss_kb roverd-sim)
+  m=$(rss_kb mapd)
   echo "$now,$r,$m" >> "$OUT/rss.csv"
   printf 'soak: %5d s  roverd %7d kB  mapd %7d kB  %s\n' "$now" "$r" "$m" \
     "$(grep -a '^t ' "$RUN_LOG" | tail -1 | cut -c1-40)"

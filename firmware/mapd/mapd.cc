@@ -743,6 +743,7 @@ void Mapd::Shutdown() {
     graph["graph_factors_refused"] = std::to_string(g.factors_refused);
     graph["graph_updates"] = std::to_string(g.updates);
     graph["graph_solves"] = std::to_string(g.solves);
+    graph["graph_idle_steps"] = std::to_string(g.refinements);
     if (!g.update_ms.empty()) {
       graph["graph_update_ms_p50"] = std::to_string(stats::Percentile(g.update_ms, 50.0));
       graph["graph_update_ms_p99"] = std::to_string(stats::Percentile(g.update_ms, 99.0));
@@ -823,12 +824,13 @@ std::string Mapd::Summary() const {
     char text[240];
     std::snprintf(text, sizeof(text),
                   "  graph: %llu factors (%llu refused), %llu updates (%llu solves, %llu failed), "
-                  "update %.2f ms p50, %.2f ms p99\n",
+                  "update %.2f ms p50, %.2f ms p99, %llu steps in idle time\n",
                   static_cast<unsigned long long>(g.factors_added),
                   static_cast<unsigned long long>(g.factors_refused),
                   static_cast<unsigned long long>(g.updates),
                   static_cast<unsigned long long>(g.solves),
-                  static_cast<unsigned long long>(g.update_errors), p50, p99);
+                  static_cast<unsigned long long>(g.update_errors), p50, p99,
+                  static_cast<unsigned long long>(g.refinements));
     out += text;
   }
   if (loop_) {

@@ -68,7 +68,7 @@ std::vector<std::string> SlamWorker::TakeProblems() {
 
 void SlamWorker::Flush() {
   std::unique_lock lock(mutex_);
-  idle_.wait(lock, [&] { return stop_ || (inbox_.empty() && !busy_); });
+  idle_.wait(lock, [&] { return stop_ || (inbox_.empty() && !busy_ && !refining_); });
 }
 
 void SlamWorker::Stop() {
@@ -87,21 +87,27 @@ void SlamWorker::Run() {
   setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
   std::unique_lock lock(mutex_);
   while (true) {
-    wake_.wait(lock, [&] { return stop_ || !inbox_.empty() || pose_changed_; });
+    // With nothing new to add, a one-step update that left the graph short
+    // of convergence goes on here, one step per pass, so that new factors
+    // never wait behind more than one step.
+    wake_.wait(lock, [&] { return stop_ || !inbox_.empty() || pose_changed_ || refining_; });
     if (stop_) return;
     std::deque<mapping::GraphFactorRecord> batch;
     batch.swap(inbox_);
     pose_changed_ = false;
     busy_ = true;
     lock.unlock();
-    UpdateOnce(&batch);
+    const bool refine = batch.empty() && graph_.NeedsRefinement();
+    UpdateOnce(&batch, refine);
+    const bool refining = graph_.NeedsRefinement();
     lock.lock();
     busy_ = false;
-    if (inbox_.empty()) idle_.notify_all();
+    refining_ = refining;
+    if (inbox_.empty() && !refining_) idle_.notify_all();
   }
 }
 
-void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch) {
+void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch, bool refine) {
   std::vector<std::string> problems;
   uint64_t added = 0;
   int64_t stamp_ns = 0;
@@ -122,9 +128,9 @@ void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch) {
   SlamSnapshot snap;
   const auto start = std::chrono::steady_clock::now();
   bool ok = true;
-  if (added > 0 || latest_.update == 0) {
+  if (added > 0 || latest_.update == 0 || refine) {
     try {
-      snap.summary = graph_.Optimize();
+      snap.summary = added > 0 || !refine ? graph_.Optimize() : graph_.Refine();
     } catch (const std::exception& e) {
       ok = false;
       problems.push_back(std::string("graph update failed: ") + e.what());
@@ -185,12 +191,15 @@ void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch) {
     ++stats_.updates;
     if (snap.summary.solved) ++stats_.solves;
     stats_.update_ms.push_back(ms);
+  } else if (refine) {
+    ++stats_.refinements;
   }
   snap.update = latest_.update + 1;
-  snap.origins_update = added > 0 || latest_.update == 0 ? snap.update : latest_.origins_update;
+  snap.origins_update =
+      added > 0 || refine || latest_.update == 0 ? snap.update : latest_.origins_update;
   snap.stamp_ns = std::max(stamp_ns, latest_.stamp_ns);
   snap.update_ms = ms;
-  if (added == 0) snap.summary = latest_.summary;
+  if (added == 0 && !refine) snap.summary = latest_.summary;
   latest_ = std::move(snap);
 }
 

@@ -36,8 +36,8 @@ struct OptimisedOrigin {
 /// The graph's state after one update.
 struct SlamSnapshot {
   uint64_t update = 0;  ///< 0: no update yet
-  /// The update that last changed the origins (a factor was added); later
-  /// updates only moved the global pose.
+  /// The update that last changed the origins (a factor was added, or an
+  /// idle-time step moved them); later updates only moved the global pose.
   uint64_t origins_update = 0;
   int64_t stamp_ns = 0;  ///< of the newest factor or pose it includes
   /// By the filter's local frame id (robot 0's origins).
@@ -57,6 +57,7 @@ struct SlamStats {
   uint64_t updates = 0;
   uint64_t solves = 0;
   uint64_t update_errors = 0;     ///< Optimize threw (e.g. a disconnected robot)
+  uint64_t refinements = 0;       ///< steps taken in idle time (RoverGraph::Refine)
   std::vector<double> update_ms;  ///< every update, for percentiles
 };
 
@@ -80,15 +81,17 @@ class SlamWorker {
   SlamStats Stats() const;
   /// Messages for refused factors and failed updates since the last call.
   std::vector<std::string> TakeProblems();
-  /// Waits until every factor submitted so far is in an update (tests, end
-  /// of a run).
+  /// Waits until every factor submitted so far is in an update and the
+  /// idle-time steps after it are done (tests, end of a run).
   void Flush();
   /// Stops the thread (idempotent; the destructor calls it).
   void Stop();
 
  private:
   void Run();
-  void UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch);
+  // Adds `batch` and optimises; with an empty batch and `refine`, takes one
+  // more step of an unconverged update instead (RoverGraph::Refine).
+  void UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch, bool refine);
 
   const int robot_;
   mapping::RoverGraph graph_;
@@ -99,6 +102,7 @@ class SlamWorker {
   bool busy_ = false;
   bool stop_ = false;
   bool pose_changed_ = false;
+  bool refining_ = false;  // the graph needs more steps (RoverGraph::NeedsRefinement)
   struct FilterPose {
     int64_t stamp_ns = 0;
     uint32_t frame_id = 0;

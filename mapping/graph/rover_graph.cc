@@ -345,6 +345,8 @@ class RoverGraph::Impl {
       const IncrementalPoseSolverStats stats = solver_->Update();
       out->refactored_columns = stats.refactored_columns;
       out->reordered = stats.reordered;
+      refine_due_ = !stats.converged;
+      refine_steps_ = 0;
       CopySolverEstimates();
     } catch (const std::runtime_error&) {
       // Singular: start the solver over; the next loop closure decides.
@@ -405,6 +407,8 @@ class RoverGraph::Impl {
     // Converging updates that do not converge fall back to Ceres; with a
     // fixed number of steps the next updates carry on from here.
     if (!stats.converged && options_.incremental_steps == 0) return Solve(out);
+    refine_due_ = !stats.converged;
+    refine_steps_ = 0;
     CopySolverEstimates();
     out.solve_time_s = Seconds(start);
     out.iterations = stats.iterations;
@@ -441,7 +445,55 @@ class RoverGraph::Impl {
     return out;
   }
 
+  bool NeedsRefinement() const {
+    return solver_ != nullptr && refine_due_;
+  }
+
+  // One incremental step on the factors already in the solver (nothing new
+  // is added: factors received since the last Optimize() wait for it).
+  RoverGraphSummary Refine() {
+    RoverGraphSummary out;
+    out.unanchored = unanchored_;
+    out.variables = static_cast<int>(variables_.size());
+    out.factors = static_cast<int>(factors_.size());
+    if (!NeedsRefinement()) {
+      out.converged = true;
+      out.final_cost = out.initial_cost = last_cost_;
+      return out;
+    }
+    const Clock::time_point start = Clock::now();
+    IncrementalPoseSolverStats stats;
+    try {
+      stats = solver_->Update();
+    } catch (const std::runtime_error&) {
+      refine_due_ = false;
+      return Solve(out);
+    }
+    ++refine_steps_;
+    refine_due_ = !stats.converged;
+    const double cost = solver_->LinearizedCost();
+    if (refine_due_ && (refine_steps_ >= MaxRefineSteps() || cost > last_cost_ * 1.001)) {
+      // As a converging update does: what undamped Gauss-Newton does not
+      // settle (a robust factor's weight swinging after a large correction
+      // raises the cost, or the steps never end), Ceres's trust region does,
+      // and the swinging estimate is never published.
+      return Solve(out);
+    }
+    CopySolverEstimates();
+    out.solve_time_s = Seconds(start);
+    out.iterations = stats.iterations;
+    out.initial_cost = last_cost_;
+    out.final_cost = last_cost_ = cost;
+    out.converged = stats.converged;
+    out.solved = true;
+    out.incremental_solve = true;
+    out.relinearized = stats.relinearized_variables;
+    out.refactored_columns = stats.refactored_columns;
+    return out;
+  }
+
   RoverGraphSummary Solve(RoverGraphSummary out) {
+    refine_due_ = false;
     AddPendingToProblem();
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -534,6 +586,13 @@ class RoverGraph::Impl {
   std::vector<GraphKey> unanchored_;
   bool solved_once_ = false;
   double last_cost_ = 0.0;
+  int MaxRefineSteps() const { return std::min(options_.max_iterations, 20); }
+
+  // A one-step update (options_.incremental_steps > 0) left the estimate
+  // short of convergence: Refine() carries on, then Ceres after
+  // MaxRefineSteps() steps.
+  bool refine_due_ = false;
+  int refine_steps_ = 0;
   struct FilterPose {
     int64_t submap = 0;
     int64_t pose = 0;
@@ -627,6 +686,10 @@ void RoverGraph::SetCurrentFilterPose(int robot, int64_t submap,
 }
 
 RoverGraphSummary RoverGraph::Optimize() { return impl_->Optimize(); }
+
+bool RoverGraph::NeedsRefinement() const { return impl_->NeedsRefinement(); }
+
+RoverGraphSummary RoverGraph::Refine() { return impl_->Refine(); }
 
 Eigen::Isometry3d RoverGraph::Estimate(const GraphKey& key) const {
   const auto it = impl_->variables_.find(key);

@@ -187,6 +187,19 @@ class RoverGraph {
   /// Throws GraphError if the graph has no prior at all.
   RoverGraphSummary Optimize();
 
+  /// True after a one-step update (options.incremental_steps > 0) that did
+  /// not converge, until Refine() converges (after 20 steps, or
+  /// max_iterations if fewer, it hands the graph to Ceres, as a converging
+  /// update does).
+  bool NeedsRefinement() const;
+  /// One more incremental Gauss-Newton step on the factors already added
+  /// (iSAM2's update without new factors), for when the caller is idle: the
+  /// estimates move on towards the optimum a loop closure's one-step update
+  /// left them short of. Origin marginals keep the values of the last
+  /// Optimize(). Returns a converged summary without work when no step is
+  /// due. Factors added since the last Optimize() are not included.
+  RoverGraphSummary Refine();
+
   /// Current estimate of a variable (T_world_key). Throws GraphError if the
   /// variable does not exist or has not been optimised yet.
   Eigen::Isometry3d Estimate(const GraphKey& key) const;
