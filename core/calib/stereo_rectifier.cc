@@ -113,6 +113,15 @@ cv::Mat StereoRectifier::FlatFieldGainQ8(const CameraModel& cam, const Eigen::Ma
   return gain;
 }
 
+cv::Mat StereoRectifier::FlatFieldGain(int index) const {
+  if (index < 0 || index > 1) return {};
+  const cv::Mat& gain_q8 = flat_field_q8_[static_cast<size_t>(index)];
+  if (gain_q8.empty()) return {};
+  cv::Mat gain;
+  gain_q8.convertTo(gain, CV_32F, 1.0 / 256.0);
+  return gain;
+}
+
 bool StereoRectifier::RectifyOne(int index, const cv::Mat& raw, cv::Mat* rect) const {
   if (index < 0 || index > 1 || rect == nullptr || raw.empty() || raw.type() != CV_8UC1 ||
       raw.size() != size_) {

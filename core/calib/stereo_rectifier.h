@@ -59,6 +59,13 @@ class StereoRectifier {
   /// Remaps one raw image of camera `index` (0 or 1); false on bad input.
   bool RectifyOne(int index, const cv::Mat& raw, cv::Mat* rect) const;
 
+  /// The gain by which RectifyOne(index) brightens each rectified pixel of
+  /// camera `index` (0 or 1) to undo its vignetting, CV_32FC1 of
+  /// image_size(); empty when that camera has none (or for a bad index).
+  /// Sensor noise is brightened with the signal: a threshold on rectified
+  /// intensities that is meant in sensor counts scales by it.
+  cv::Mat FlatFieldGain(int index) const;
+
   /// The pinhole matrix of both rectified images.
   const RectifiedIntrinsics& intrinsics() const { return intrinsics_; }
   /// Distance between the rectified optical centres [m] (> 0).

@@ -62,7 +62,9 @@ LocalMapper::LocalMapper(const LocalMapperOptions& options, const calib::CameraM
       rectifier_(MakeRectifier(cam0, cam1)),
       stereo_(StereoOf(rectifier_)),
       error_model_(stereo_, options.pixel_error_px),
-      disparity_(options.disparity),
+      // The texture threshold counts sensor noise, which the rectifier's
+      // flat field brightens towards the corners.
+      disparity_(options.disparity, rectifier_.FlatFieldGain(0)),
       steps_(options.steps, error_model_),
       edges_(options.negative_edges),
       obstacle_marker_(options.obstacle_cells, options.steps),

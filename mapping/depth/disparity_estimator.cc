@@ -61,8 +61,24 @@ void DisparityOptions::Validate() const {
   ModeOf(mode);
 }
 
-DisparityEstimator::DisparityEstimator(const DisparityOptions& options) : options_(options) {
+DisparityEstimator::DisparityEstimator(const DisparityOptions& options, const cv::Mat& left_gain)
+    : options_(options) {
   options_.Validate();
+  if (!left_gain.empty()) {
+    double min_gain = 0.0;
+    if (left_gain.type() != CV_32FC1) {
+      throw std::invalid_argument(
+          "DisparityEstimator: expected the left gain as CV_32FC1, found OpenCV type " +
+          std::to_string(left_gain.type()));
+    }
+    cv::minMaxLoc(left_gain, &min_gain);
+    if (!(min_gain > 0.0)) {
+      throw std::invalid_argument(
+          "DisparityEstimator: expected a left gain > 0 everywhere, found " +
+          std::to_string(min_gain));
+    }
+    min_texture_ = left_gain * options_.min_texture_dn;
+  }
   const int area = options_.block_size_px * options_.block_size_px;
   sgbm_ = cv::StereoSGBM::create(
       options_.min_disparity_px, options_.num_disparities_px, options_.block_size_px,
@@ -82,6 +98,12 @@ void DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& right,
                                 " and " + std::to_string(right.cols) + "x" +
                                 std::to_string(right.rows));
   }
+  if (!min_texture_.empty() && left.size() != min_texture_.size()) {
+    throw std::invalid_argument("DisparityEstimator: expected images of the left gain's size " +
+                                std::to_string(min_texture_.cols) + "x" +
+                                std::to_string(min_texture_.rows) + ", found " +
+                                std::to_string(left.cols) + "x" + std::to_string(left.rows));
+  }
   sgbm_->compute(left, right, *disparity_q4);
   // The matching window runs off the image within half a block of its
   // border: SGBM's values there (zero disparity, often) mean nothing, and
@@ -100,8 +122,13 @@ void DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& right,
     cv::Sobel(left, gradient, CV_32F, 1, 0, 3, 1.0 / 8.0);
     cv::Mat texture;
     cv::boxFilter(cv::abs(gradient), texture, CV_32F, cv::Size(7, 7));
-    disparity_q4->setTo(cv::Scalar(InvalidValue()),
-                        texture < static_cast<float>(options_.min_texture_dn));
+    // In sensor counts: a brightened pixel's noise was brightened too.
+    if (min_texture_.empty()) {
+      disparity_q4->setTo(cv::Scalar(InvalidValue()),
+                          texture < static_cast<float>(options_.min_texture_dn));
+    } else {
+      disparity_q4->setTo(cv::Scalar(InvalidValue()), texture < min_texture_);
+    }
   }
 }
 

@@ -35,11 +35,14 @@ struct DisparityOptions {
   /// "sgbm" (5 directions), "sgbm_3way" (faster) or "hh" (8 directions).
   std::string mode = "sgbm_3way";
   /// Texture filter: pixels whose mean horizontal intensity gradient over a
-  /// 7x7 window is below this (digital numbers per pixel) get no disparity.
-  /// SGBM's smoothness terms otherwise carry disparities into textureless
-  /// regions (sky, deep shadow), where they are matched sensor noise: on the
-  /// simulator's pairs the sky measures 0.4-0.7 DN/px, in-range ground
-  /// 1.5-4.5. 0 disables the filter.
+  /// 7x7 window is below this (digital numbers per pixel, as the sensor
+  /// counted them) get no disparity. SGBM's smoothness terms otherwise carry
+  /// disparities into textureless regions (sky, deep shadow), where they are
+  /// matched sensor noise: on the simulator's pairs the sky measures 0.4-0.9
+  /// DN/px, in-range ground 1.5-4.5. Where the left image was brightened
+  /// after capture (a flat-field correction, see DisparityEstimator), its
+  /// noise was too, and the threshold scales with the gain. 0 disables the
+  /// filter.
   double min_texture_dn = 1.0;
 
   /// Absent keys keep their defaults; unknown keys are the caller's to check.
@@ -50,10 +53,18 @@ struct DisparityOptions {
 
 class DisparityEstimator {
  public:
-  explicit DisparityEstimator(const DisparityOptions& options);
+  /// `left_gain`: the gain each pixel of the rectified left image was
+  /// brightened by after capture (calib::StereoRectifier::FlatFieldGain(0),
+  /// CV_32FC1 of the image size, every value > 0), or empty for none. It
+  /// scales the texture threshold per pixel: a gain of 1.5 in the corners
+  /// brightens the sky's noise from 0.7 to 1.05 DN/px, past a fixed
+  /// threshold, and SGBM matches it. Throws std::invalid_argument for
+  /// invalid options or gain.
+  explicit DisparityEstimator(const DisparityOptions& options, const cv::Mat& left_gain = {});
 
-  /// Disparity of the rectified mono8 pair (same size). Throws
-  /// std::invalid_argument naming what is wrong with the images.
+  /// Disparity of the rectified mono8 pair (same size, and the size of the
+  /// left gain if there is one). Throws std::invalid_argument naming what is
+  /// wrong with the images.
   void Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* disparity_q4) const;
 
   const DisparityOptions& options() const { return options_; }
@@ -63,6 +74,9 @@ class DisparityEstimator {
  private:
   DisparityOptions options_;
   cv::Ptr<cv::StereoSGBM> sgbm_;
+  /// min_texture_dn times the left gain per pixel (CV_32FC1); empty when
+  /// there is no gain and the scalar threshold applies everywhere.
+  cv::Mat min_texture_;
 };
 
 }  // namespace rover::mapping

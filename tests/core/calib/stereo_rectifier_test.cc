@@ -145,6 +145,21 @@ TEST(StereoRectifierTest, UndoesTheCalibratedVignetting) {
       }
     }
   }
+  // The gain it applied, per pixel: what a raw pixel was multiplied by.
+  EXPECT_TRUE(flat->FlatFieldGain(0).empty());
+  EXPECT_TRUE(corrected->FlatFieldGain(2).empty());
+  for (int i = 0; i < 2; ++i) {
+    const cv::Mat gain = corrected->FlatFieldGain(i);
+    ASSERT_EQ(gain.type(), CV_32FC1);
+    ASSERT_EQ(gain.size(), corrected->image_size());
+    const cv::Mat raw = VignettedFlatScene(i == 0 ? c0 : c1, kStrength, kLevel);
+    cv::Mat dark;
+    ASSERT_TRUE(flat->RectifyOne(i, raw, &dark));
+    for (const cv::Point at : {cv::Point(20, 20), cv::Point(dark.cols / 2, dark.rows / 2)}) {
+      EXPECT_NEAR(dark.at<uint8_t>(at) * gain.at<float>(at), kLevel, 2.5) << "camera " << i;
+    }
+    EXPECT_GT(gain.at<float>(20, 20), 1.2f);
+  }
 }
 
 TEST(StereoRectifierTest, RejectsMixedDistortionModels) {

@@ -1,5 +1,6 @@
 // Disparity to depth: SGBM on a synthetic textured plane recovers its
-// depth; invalid, infinitely far, too uncertain and valid pixels stay apart.
+// depth; invalid, infinitely far, too uncertain and valid pixels stay apart;
+// the texture filter counts sensor noise, also where the image was brightened.
 
 #include "mapping/depth/depth_image.h"
 
@@ -109,6 +110,59 @@ TEST(DisparityEstimatorTest, TexturelessRegionsAndTheBorderGetNoDisparity) {
   // Half a block (5 px: 2) plus one around the border: none.
   EXPECT_EQ(matched(with, 0, h, w - 3, w), 0);
   EXPECT_EQ(matched(with, h - 3, h, 0, w), 0);
+}
+
+TEST(DisparityEstimatorTest, TheTextureThresholdScalesWithTheLeftImagesGain) {
+  // The sky of the test above brightened 4x after capture, as a flat field
+  // brightens a vignetted corner: its noise (about 0.35 DN/px) now measures
+  // 1.4 DN/px in the image, but still 0.35 in sensor counts.
+  const int w = 320, h = 240;
+  cv::Mat texture(h, w + 64, CV_8UC1);
+  cv::RNG rng(5);
+  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
+  cv::Mat sky = texture.rowRange(0, h / 3);
+  rng.fill(sky, cv::RNG::NORMAL, 30, 1);
+  constexpr float kSkyGain = 4.0f;
+  sky.convertTo(sky, CV_8U, kSkyGain);
+  const cv::Mat left = texture(cv::Rect(32, 0, w, h)).clone();
+  const cv::Mat right = texture(cv::Rect(52, 0, w, h)).clone();
+  cv::Mat gain(h, w, CV_32FC1, cv::Scalar(1.0f));
+  gain.rowRange(0, h / 3).setTo(kSkyGain);
+  const DisparityEstimator with_gain({}, gain);
+  const DisparityEstimator without_gain({});
+  cv::Mat with, without;
+  with_gain.Compute(left, right, &with);
+  without_gain.Compute(left, right, &without);
+  const auto matched = [](const cv::Mat& d, int row0, int row1, int col0, int col1) {
+    int n = 0;
+    for (int v = row0; v < row1; ++v) {
+      for (int u = col0; u < col1; ++u) n += d.at<int16_t>(v, u) >= 0 ? 1 : 0;
+    }
+    return n;
+  };
+  EXPECT_GT(matched(without, 10, h / 3 - 10, 80, w - 10), 100)
+      << "a threshold in image counts passes the brightened noise";
+  EXPECT_EQ(matched(with, 10, h / 3 - 10, 80, w - 10), 0);
+  EXPECT_GT(matched(with, h / 3 + 10, h - 10, 80, w - 10), 0.95 * (h - h / 3 - 20) * (w - 90))
+      << "the textured part keeps its disparities";
+}
+
+TEST(DisparityEstimatorTest, RejectsABadLeftGainNamingIt) {
+  EXPECT_THROW(DisparityEstimator({}, cv::Mat(4, 4, CV_16UC1, cv::Scalar(256))),
+               std::invalid_argument);
+  EXPECT_THROW(DisparityEstimator({}, cv::Mat(4, 4, CV_32FC1, cv::Scalar(0.0f))),
+               std::invalid_argument);
+  const DisparityEstimator sgbm({}, cv::Mat(4, 4, CV_32FC1, cv::Scalar(1.5f)));
+  const cv::Mat image(240, 320, CV_8UC1, cv::Scalar(0));
+  cv::Mat disparity;
+  try {
+    sgbm.Compute(image, image, &disparity);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("left gain's size 4x4, found 320x240"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(DisparityOptionsTest, RejectsBadValuesNamingThem) {
