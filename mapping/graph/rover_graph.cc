@@ -445,9 +445,7 @@ class RoverGraph::Impl {
     return out;
   }
 
-  bool NeedsRefinement() const {
-    return solver_ != nullptr && refine_due_;
-  }
+  bool NeedsRefinement() const { return solver_ != nullptr && refine_due_; }
 
   // One incremental step on the factors already in the solver (nothing new
   // is added: factors received since the last Optimize() wait for it).
