@@ -641,6 +641,8 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
     // the rocks from opposite sides), under stricter checks below.
     r.from_prior = true;
     r.T_a_b_initial = prior.T_a_b;
+    r.inliers.clear();  // of a hypothesis that failed
+    r.inlier_ratio = 0.0;
     const std::string rejection = RefineAndCheck(o, a, b, bounds, &r);
     return finish(rejection.empty() ? rejection
                                     : no_hypothesis + "; aligned from the prior: " + rejection);
