@@ -77,18 +77,44 @@ TEST(DepthImageTest, SgbmRecoversATexturedPlane) {
   EXPECT_THROW(sgbm.Compute(left, cv::Mat(), &disparity), std::invalid_argument);
 }
 
-TEST(DisparityEstimatorTest, TexturelessRegionsAndTheBorderGetNoDisparity) {
-  // The textured plane of the test above, with a band of flat grey plus
-  // faint noise (a sky: 1 DN) across its top third.
-  const int w = 320, h = 240;
+// A textured plane 20 px of disparity away with a band of flat grey plus
+// faint noise (a sky: 1 DN) across its top third, the sky brightened by
+// `sky_gain` after capture; left and right images of w x h.
+struct SkyScene {
+  static constexpr int w = 320, h = 240;
+  cv::Mat left, right;
+};
+
+SkyScene MakeSkyScene(double sky_gain = 1.0) {
+  SkyScene scene;
+  const int w = SkyScene::w, h = SkyScene::h;
   cv::Mat texture(h, w + 64, CV_8UC1);
   cv::RNG rng(5);
   rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
   cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
   cv::Mat sky = texture.rowRange(0, h / 3);
   rng.fill(sky, cv::RNG::NORMAL, 30, 1);
-  const cv::Mat left = texture(cv::Rect(32, 0, w, h)).clone();
-  const cv::Mat right = texture(cv::Rect(52, 0, w, h)).clone();
+  if (sky_gain != 1.0) sky.convertTo(sky, CV_8U, sky_gain);
+  scene.left = texture(cv::Rect(32, 0, w, h)).clone();
+  scene.right = texture(cv::Rect(52, 0, w, h)).clone();
+  return scene;
+}
+
+// Pixels of rows [row0, row1) x columns [col0, col1) with a disparity.
+int MatchedPixels(const cv::Mat& d, int row0, int row1, int col0, int col1) {
+  int n = 0;
+  for (int v = row0; v < row1; ++v) {
+    for (int u = col0; u < col1; ++u) n += d.at<int16_t>(v, u) >= 0 ? 1 : 0;
+  }
+  return n;
+}
+
+TEST(DisparityEstimatorTest, TexturelessRegionsAndTheBorderGetNoDisparity) {
+  // The textured plane of the test above, with a sky across its top third.
+  const SkyScene scene = MakeSkyScene();
+  const int w = SkyScene::w, h = SkyScene::h;
+  const cv::Mat& left = scene.left;
+  const cv::Mat& right = scene.right;
   const DisparityEstimator filtered({});
   DisparityOptions unfiltered_options;
   unfiltered_options.min_texture_dn = 0.0;
@@ -96,37 +122,24 @@ TEST(DisparityEstimatorTest, TexturelessRegionsAndTheBorderGetNoDisparity) {
   cv::Mat with, without;
   filtered.Compute(left, right, &with);
   unfiltered.Compute(left, right, &without);
-  const auto matched = [](const cv::Mat& d, int row0, int row1, int col0, int col1) {
-    int n = 0;
-    for (int v = row0; v < row1; ++v) {
-      for (int u = col0; u < col1; ++u) n += d.at<int16_t>(v, u) >= 0 ? 1 : 0;
-    }
-    return n;
-  };
-  EXPECT_GT(matched(without, 10, h / 3 - 10, 80, w - 10), 100) << "SGBM matches the noise";
-  EXPECT_EQ(matched(with, 10, h / 3 - 10, 80, w - 10), 0);
-  EXPECT_GT(matched(with, h / 3 + 10, h - 10, 80, w - 10), 0.95 * (h - h / 3 - 20) * (w - 90))
+  EXPECT_GT(MatchedPixels(without, 10, h / 3 - 10, 80, w - 10), 100) << "SGBM matches the noise";
+  EXPECT_EQ(MatchedPixels(with, 10, h / 3 - 10, 80, w - 10), 0);
+  EXPECT_GT(MatchedPixels(with, h / 3 + 10, h - 10, 80, w - 10), 0.95 * (h - h / 3 - 20) * (w - 90))
       << "the textured part keeps its disparities";
   // Half a block (5 px: 2) plus one around the border: none.
-  EXPECT_EQ(matched(with, 0, h, w - 3, w), 0);
-  EXPECT_EQ(matched(with, h - 3, h, 0, w), 0);
+  EXPECT_EQ(MatchedPixels(with, 0, h, w - 3, w), 0);
+  EXPECT_EQ(MatchedPixels(with, h - 3, h, 0, w), 0);
 }
 
 TEST(DisparityEstimatorTest, TheTextureThresholdScalesWithTheLeftImagesGain) {
   // The sky of the test above brightened 4x after capture, as a flat field
   // brightens a vignetted corner: its noise (about 0.35 DN/px) now measures
   // 1.4 DN/px in the image, but still 0.35 in sensor counts.
-  const int w = 320, h = 240;
-  cv::Mat texture(h, w + 64, CV_8UC1);
-  cv::RNG rng(5);
-  rng.fill(texture, cv::RNG::UNIFORM, 0, 255);
-  cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
-  cv::Mat sky = texture.rowRange(0, h / 3);
-  rng.fill(sky, cv::RNG::NORMAL, 30, 1);
   constexpr float kSkyGain = 4.0f;
-  sky.convertTo(sky, CV_8U, kSkyGain);
-  const cv::Mat left = texture(cv::Rect(32, 0, w, h)).clone();
-  const cv::Mat right = texture(cv::Rect(52, 0, w, h)).clone();
+  const SkyScene scene = MakeSkyScene(kSkyGain);
+  const int w = SkyScene::w, h = SkyScene::h;
+  const cv::Mat& left = scene.left;
+  const cv::Mat& right = scene.right;
   cv::Mat gain(h, w, CV_32FC1, cv::Scalar(1.0f));
   gain.rowRange(0, h / 3).setTo(kSkyGain);
   const DisparityEstimator with_gain({}, gain);
@@ -134,17 +147,10 @@ TEST(DisparityEstimatorTest, TheTextureThresholdScalesWithTheLeftImagesGain) {
   cv::Mat with, without;
   with_gain.Compute(left, right, &with);
   without_gain.Compute(left, right, &without);
-  const auto matched = [](const cv::Mat& d, int row0, int row1, int col0, int col1) {
-    int n = 0;
-    for (int v = row0; v < row1; ++v) {
-      for (int u = col0; u < col1; ++u) n += d.at<int16_t>(v, u) >= 0 ? 1 : 0;
-    }
-    return n;
-  };
-  EXPECT_GT(matched(without, 10, h / 3 - 10, 80, w - 10), 100)
+  EXPECT_GT(MatchedPixels(without, 10, h / 3 - 10, 80, w - 10), 100)
       << "a threshold in image counts passes the brightened noise";
-  EXPECT_EQ(matched(with, 10, h / 3 - 10, 80, w - 10), 0);
-  EXPECT_GT(matched(with, h / 3 + 10, h - 10, 80, w - 10), 0.95 * (h - h / 3 - 20) * (w - 90))
+  EXPECT_EQ(MatchedPixels(with, 10, h / 3 - 10, 80, w - 10), 0);
+  EXPECT_GT(MatchedPixels(with, h / 3 + 10, h - 10, 80, w - 10), 0.95 * (h - h / 3 - 20) * (w - 90))
       << "the textured part keeps its disparities";
 }
 

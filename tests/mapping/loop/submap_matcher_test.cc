@@ -43,14 +43,22 @@ Built Build(const LoopWorld& world, const Eigen::Vector2d& start, double yaw, ui
   return b;
 }
 
+// A prior `offset` (x, y, z in m, then yaw in rad) off the truth, with
+// standard deviations sigma_m in x, y, z and sigma_yaw_rad in yaw.
+MatchPrior PriorOff(const Isometry3d& truth, const Eigen::Vector4d& offset, double sigma_m,
+                    double sigma_yaw_rad) {
+  MatchPrior p;
+  p.T_a_b = truth * GravityAlignedTransform(offset.head<3>(), offset(3));
+  p.covariance = Matrix6d::Zero();
+  const double v = sigma_m * sigma_m;
+  p.covariance.diagonal() << v, v, v, 1e-4, 1e-4, sigma_yaw_rad * sigma_yaw_rad;
+  return p;
+}
+
 // A prior off the truth by (0.3, -0.2, 0.05) m and 3 deg, with sigma 0.5 m
 // and 5 deg: a loop closure after some drift.
 MatchPrior PriorNear(const Isometry3d& truth) {
-  MatchPrior p;
-  p.T_a_b = truth * GravityAlignedTransform({0.3, -0.2, 0.05}, 3.0 * kDeg);
-  p.covariance = Matrix6d::Zero();
-  p.covariance.diagonal() << 0.25, 0.25, 0.25, 1e-4, 1e-4, std::pow(5.0 * kDeg, 2);
-  return p;
+  return PriorOff(truth, {0.3, -0.2, 0.05, 3.0 * kDeg}, 0.5, 5.0 * kDeg);
 }
 
 class SubmapMatcherTest : public ::testing::Test {
@@ -202,11 +210,7 @@ TEST_F(SubmapMatcherTest, KeypointsAlongALineAreNotAcceptedWhenTheCloudSlides) {
 // A prior as tight as after a short drive: off the truth by (0.08, -0.05)
 // m and 0.3 deg, sigma 0.08 m and 0.4 deg.
 MatchPrior TightPriorNear(const Isometry3d& truth) {
-  MatchPrior p;
-  p.T_a_b = truth * GravityAlignedTransform({0.08, -0.05, 0.02}, 0.3 * kDeg);
-  p.covariance = Matrix6d::Zero();
-  p.covariance.diagonal() << 0.0064, 0.0064, 0.0064, 1e-4, 1e-4, std::pow(0.4 * kDeg, 2);
-  return p;
+  return PriorOff(truth, {0.08, -0.05, 0.02, 0.3 * kDeg}, 0.08, 0.4 * kDeg);
 }
 
 // Options under which no descriptor corresponds (as between two submaps that
