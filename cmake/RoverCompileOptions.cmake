@@ -16,6 +16,13 @@ if(ROVER_WARNINGS_AS_ERRORS)
   target_compile_options(rover_warnings INTERFACE -Werror)
 endif()
 
+# Compressed debug sections. Debug info is most of the build tree (every test
+# links Eigen, OpenCV and Ceres templates); zlib halves it for about 2 % more
+# compile time, which keeps the dev, ASan and TSan trees of a CI clone small.
+# Applies to every target, third-party included, and is a no-op without -g.
+add_compile_options(-gz)
+add_link_options(-gz)
+
 # Applies the project defaults to a target: include root, warnings.
 function(rover_target_defaults target)
   target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)

@@ -27,6 +27,7 @@ void LoopCloserOptions::Validate() const {
   data.Validate();
   pairing.Validate();
   matcher.Validate();
+  store.Validate();
   if (max_queued_pairs < 1 || max_queued_pairs > 1000) {
     throw std::invalid_argument("LoopCloserOptions.max_queued_pairs: expected 1..1000, found " +
                                 std::to_string(max_queued_pairs));
@@ -57,6 +58,11 @@ LoopCloserOptions LoopCloserOptions::Load(const ConfigNode& node) {
   }
   o.max_queued_pairs = node.Get<int>("max_queued_pairs", o.max_queued_pairs);
   o.nice_increment = node.Get<int>("nice_increment", o.nice_increment);
+  if (node.Has("store")) {
+    const ConfigNode store = node.Child("store");
+    o.store.resident_submaps = store.Get<int>("resident_submaps", o.store.resident_submaps);
+    o.store.spill_directory = store.Get<std::string>("spill_directory", o.store.spill_directory);
+  }
   o.Validate();
   return o;
 }
@@ -66,6 +72,7 @@ LoopCloser::LoopCloser(const LoopCloserOptions& options, int robot)
       robot_(robot),
       matcher_(options.matcher),
       pairing_(options.pairing),
+      store_(options.store, options.data),
       pairing_thread_([this] { RunPairing(); }),
       matching_thread_([this] { RunMatching(); }) {}
 
@@ -106,7 +113,9 @@ std::vector<std::string> LoopCloser::TakeProblems() {
 
 LoopCloserStats LoopCloser::Stats() const {
   const std::lock_guard lock(mutex_);
-  return stats_;
+  LoopCloserStats stats = stats_;
+  stats.store = store_.Stats();
+  return stats;
 }
 
 bool LoopCloser::PairingIdle() const {
@@ -172,7 +181,22 @@ void LoopCloser::PrepareWaiting(std::unique_lock<std::mutex>* lock) {
     }
     stats_.data_ms.push_back(data->build_ms());
     if (data->suitable()) ++stats_.submaps_suitable;
-    prepared_[frame] = Prepared{data, false, false};
+    prepared_[frame] = Prepared{};
+    try {
+      store_.Put(frame, std::move(data));
+    } catch (const std::exception& e) {  // stored all the same, in memory
+      problems_.push_back(std::string("loop closures: ") + e.what());
+    }
+  }
+}
+
+std::shared_ptr<const mapping::SubmapMatchData> LoopCloser::StoredData(int64_t frame) {
+  try {
+    return store_.Get(frame);
+  } catch (const std::exception& e) {
+    problems_.push_back("loop closures: submap " + std::to_string(frame) +
+                        " leaves the pairing: " + e.what());
+    return nullptr;
   }
 }
 
@@ -185,15 +209,17 @@ void LoopCloser::SyncPairing() {
     const mapping::SubmapId id{robot_, frame};
     if (!p.paired) {
       p.paired = true;
+      const std::shared_ptr<const mapping::SubmapMatchData> data = StoredData(frame);
+      if (!data) continue;
       try {
-        pairing_.AddSubmap(id, *p.data, origin->second.T_world_origin, origin->second.covariance);
+        pairing_.AddSubmap(id, *data, origin->second.T_world_origin, origin->second.covariance);
         p.in_pairing = true;
       } catch (const std::exception& e) {
         problems_.push_back("loop closures: submap " + std::to_string(frame) +
                             " left out of the pairing: " + e.what());
       }
       // The pairing keeps what it needs of an unsuitable submap.
-      if (!p.in_pairing || !p.data->suitable()) p.data.reset();
+      if (!p.in_pairing || !data->suitable()) store_.Erase(frame);
     } else if (changed && p.in_pairing) {
       try {
         pairing_.UpdateOrigin(id, origin->second.T_world_origin, origin->second.covariance);
@@ -209,12 +235,16 @@ void LoopCloser::QueuePairs() {
   while (queue_.size() < static_cast<std::size_t>(options_.max_queued_pairs)) {
     std::optional<mapping::SubmapPair> next = pairing_.Next();
     if (!next) break;
-    const auto a = prepared_.find(next->a.index);
-    const auto b = prepared_.find(next->b.index);
-    if (a == prepared_.end() || b == prepared_.end() || !a->second.data || !b->second.data) {
-      continue;  // another robot's submap: not matched here
+    // Another robot's submap is not matched here; one whose data cannot
+    // be read back is not matched at all (noted as a problem).
+    if (next->a.robot != robot_ || next->b.robot != robot_ ||
+        !store_.Contains(next->a.index) || !store_.Contains(next->b.index)) {
+      continue;
     }
-    queue_.push_back(QueuedPair{*next, a->second.data, b->second.data});
+    std::shared_ptr<const mapping::SubmapMatchData> a = StoredData(next->a.index);
+    std::shared_ptr<const mapping::SubmapMatchData> b = StoredData(next->b.index);
+    if (!a || !b) continue;
+    queue_.push_back(QueuedPair{*next, std::move(a), std::move(b)});
   }
   if (!queue_.empty()) wake_matching_.notify_all();
 }

@@ -12,8 +12,11 @@
 // mapd's main loop takes the results (TakeMatches) and adds the accepted
 // ones to the pose graph as c factors; loop closures never reach the filter.
 // A submap's matching data outlives the submap itself (mapd drops the
-// octree once it is archived); the data of a submap the pairing refused as
-// unsuitable is dropped at once.
+// octree once it is archived) and stays for the whole mission, as any later
+// submap may pair with it: in a MatchDataStore, which keeps the recently
+// used in memory and spills the rest to disk, so that memory stays flat on
+// a long mission. The data of a submap the pairing refused as unsuitable is
+// dropped at once.
 
 #include <cmath>
 #include <condition_variable>
@@ -28,6 +31,7 @@
 
 #include "core/config/config.h"
 #include "firmware/mapd/slam_worker.h"
+#include "mapping/loop/match_data_store.h"
 #include "mapping/loop/submap_match_data.h"
 #include "mapping/loop/submap_matcher.h"
 #include "mapping/loop/submap_pairing.h"
@@ -65,11 +69,14 @@ struct LoopCloserOptions {
   int max_queued_pairs = 2;
   /// Nice increment of both threads over mapd's main loop.
   int nice_increment = 10;
+  /// Where the match data live (memory bound, spill directory).
+  mapping::MatchDataStoreOptions store{};
 
   /// Throws std::invalid_argument naming the key.
   void Validate() const;
-  /// Keys: data, pairing, matcher (child maps, as their Load), and the
-  /// fields above (all optional).
+  /// Keys: data, pairing, matcher (child maps, as their Load), store
+  /// (resident_submaps, spill_directory) and the fields above (all
+  /// optional).
   static LoopCloserOptions Load(const ConfigNode& node);
 };
 
@@ -99,6 +106,7 @@ struct LoopCloserStats {
   uint64_t matches_accepted = 0;
   std::vector<double> data_ms;   ///< per submap
   std::vector<double> match_ms;  ///< per matched pair
+  mapping::MatchDataStoreStats store;
 };
 
 class LoopCloser {
@@ -129,7 +137,6 @@ class LoopCloser {
 
  private:
   struct Prepared {
-    std::shared_ptr<const mapping::SubmapMatchData> data;
     bool paired = false;      ///< tried to add to the pairing
     bool in_pairing = false;  ///< added
   };
@@ -143,6 +150,9 @@ class LoopCloser {
   void SyncPairing();
   /// Pairing thread, lock held: moves candidates into the match queue.
   void QueuePairs();
+  /// Lock held: the store's data for `frame`, null (and a problem noted) if
+  /// it cannot be read back.
+  std::shared_ptr<const mapping::SubmapMatchData> StoredData(int64_t frame);
   bool PairingIdle() const;
 
   const LoopCloserOptions options_;
@@ -158,6 +168,7 @@ class LoopCloser {
   bool origins_changed_ = false;
   mapping::SubmapPairing pairing_;
   std::map<int64_t, Prepared> prepared_;  ///< by frame id
+  mapping::MatchDataStore store_;         ///< by frame id; suitable submaps only once paired
   struct QueuedPair {
     mapping::SubmapPair pair;
     std::shared_ptr<const mapping::SubmapMatchData> a;

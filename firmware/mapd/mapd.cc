@@ -186,7 +186,14 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
     slam_ = std::make_unique<SlamWorker>(options_.graph, options_.robot_id);
     LoadResumeCandidate();
     if (options_.mapping && options_.loop_closures) {
-      loop_ = std::make_unique<LoopCloser>(options_.loop, options_.robot_id);
+      LoopCloserOptions loop = options_.loop;
+      // Spilled match data go beside mapd's log (the board's log partition,
+      // not a RAM-backed /tmp) unless the configuration names a directory.
+      if (loop.store.spill_directory.empty() && !options_.output_stem.empty()) {
+        loop.store.spill_directory =
+            std::filesystem::path(options_.output_stem).parent_path().string();
+      }
+      loop_ = std::make_unique<LoopCloser>(loop, options_.robot_id);
     }
   }
   trigger_.RequestAtNextPose();
@@ -761,6 +768,9 @@ void Mapd::Shutdown() {
     if (!l.data_ms.empty()) {
       graph["match_data_ms_p50"] = std::to_string(stats::Percentile(l.data_ms, 50.0));
     }
+    graph["match_data_resident"] = std::to_string(l.store.resident);
+    graph["match_data_spilled_bytes"] = std::to_string(l.store.spilled_bytes);
+    graph["match_data_spill_reads"] = std::to_string(l.store.spill_reads);
   }
   std::map<std::string, std::string> statistics = {
       {"submaps", std::to_string(stats_.submaps_archived)},
@@ -837,14 +847,18 @@ std::string Mapd::Summary() const {
     const LoopCloserStats l = loop_->Stats();
     const double data_p50 = PercentileOrZero(l.data_ms, 50.0);
     const double match_p50 = PercentileOrZero(l.match_ms, 50.0);
-    char text[240];
+    char text[360];
     std::snprintf(text, sizeof(text),
                   "  loop closures: %llu accepted of %llu pairs matched; %llu of %llu submaps "
-                  "suitable (data %.0f ms p50); match %.0f ms p50\n",
+                  "suitable (data %.0f ms p50); match %.0f ms p50; match data: %zu of %zu in "
+                  "memory, %.1f MB spilled, %llu read back\n",
                   static_cast<unsigned long long>(stats_.loop_closures),
                   static_cast<unsigned long long>(l.pairs_matched),
                   static_cast<unsigned long long>(l.submaps_suitable),
-                  static_cast<unsigned long long>(l.submaps), data_p50, match_p50);
+                  static_cast<unsigned long long>(l.submaps), data_p50, match_p50,
+                  l.store.resident, l.store.submaps,
+                  static_cast<double>(l.store.spilled_bytes) / 1e6,
+                  static_cast<unsigned long long>(l.store.spill_reads));
     out += text;
   }
   char line[200];

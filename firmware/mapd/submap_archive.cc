@@ -8,6 +8,7 @@
 #include "core/log/msgs/rover_msgs.h"
 #include "firmware/mapd/mapd.h"
 #include "mapping/compose/map_export.h"
+#include "mapping/compose/submap_log.h"
 #include "mapping/slam/graph_log.h"
 #include "mapping/submap/submap_messages.h"
 
@@ -24,7 +25,8 @@ Eigen::Isometry3d TransformOf(const runtime::topics::FrameSwitchMsg& r) {
 
 SubmapArchive::SubmapArchive(const std::string& log_stem, const std::string& robot_name,
                              const mapping::MapComposerOptions& composer)
-    : log_stem_(log_stem), robot_name_(robot_name), composer_(composer) {
+    : log_stem_(log_stem), robot_name_(robot_name), composer_options_(composer) {
+  composer_options_.Validate();
   if (!log_stem_.empty()) {
     log_path_ = log_stem_ + ".mcap";
     log_ = std::make_unique<MapLog>(log_path_);
@@ -53,8 +55,7 @@ ArchivedBytes SubmapArchive::Add(const SubmapRecord& record, const mapping::Subm
   header.frame_id =
       log::FrameId::Truncated("local/" + robot_name_ + "/" + std::to_string(submap.frame_id()));
   const log::octomap_msgs::Octomap octomap = mapping::ToOctomapMsg(submap.octree(), header);
-  auto cloud = std::make_shared<const mapping::PointCloud>(submap.cloud());
-  const log::sensor_msgs::PointCloud2 points = mapping::ToPointCloud2(*cloud, header);
+  const log::sensor_msgs::PointCloud2 points = mapping::ToPointCloud2(submap.cloud(), header);
   bytes.octree = log::SerializedSize(octomap);
   bytes.cloud = log::SerializedSize(points);
 
@@ -87,14 +88,6 @@ ArchivedBytes SubmapArchive::Add(const SubmapRecord& record, const mapping::Subm
   // The origin may have arrived after the record was opened (topics are not
   // ordered): chain it now.
   if (T_map_frame_.count(record.frame_id) == 0) OpenFrame(record);
-  const auto placed = T_map_frame_.find(record.frame_id);
-  if (placed == T_map_frame_.end()) {
-    ++unplaced_;
-    return bytes;
-  }
-  composer_.SetSubmap(record.index, std::make_shared<const octomap::OcTree>(submap.octree()), cloud,
-                      placed->second);
-  composed_index_of_frame_[record.frame_id] = record.index;
   return bytes;
 }
 
@@ -125,10 +118,6 @@ void SubmapArchive::SetOrigins(const std::map<int64_t, Eigen::Isometry3d>& T_wor
     if (frame < 0 || frame > UINT32_MAX) continue;
     const auto id = static_cast<uint32_t>(frame);
     T_map_frame_[id] = T_map_world * T;
-    const auto composed = composed_index_of_frame_.find(id);
-    if (composed != composed_index_of_frame_.end()) {
-      composer_.SetOrigin(composed->second, T_map_frame_[id]);
-    }
   }
 }
 
@@ -144,11 +133,43 @@ void SubmapArchive::Close(const std::map<std::string, std::string>& statistics) 
   log_->WriteMetadata("mapd_statistics", statistics);
   log_->Close();
   if (T_map_frame_.empty()) return;
+  try {
+    ExportMap();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mapd: the global map was not exported: %s\n", e.what());
+  }
+}
+
+void SubmapArchive::ExportMap() {
+  // Submaps are merged a few at a time and released: the export holds the
+  // map and those few, not every submap of the mission.
+  constexpr int kSubmapsPerMerge = 8;
+  mapping::MapComposer composer(composer_options_);
+  int unmerged = 0;
+  const mapping::SubmapLog read =
+      mapping::ForEachLoggedSubmap(log_path_, [&](mapping::LoggedSubmap&& submap) {
+        const auto placed = T_map_frame_.find(submap.info.frame_id);
+        if (placed == T_map_frame_.end()) {
+          ++unplaced_;
+          return;
+        }
+        composer.SetSubmap(submap.info.index, std::move(submap.octree), std::move(submap.cloud),
+                           placed->second);
+        if (++unmerged == kSubmapsPerMerge) {
+          composer.MergeAndRelease();
+          unmerged = 0;
+        }
+      });
+  for (const std::string& problem : read.problems) {
+    std::fprintf(stderr, "mapd: composing the global map from %s: %s\n", log_path_.c_str(),
+                 problem.c_str());
+  }
   // The global map in the first submap's frame.
-  const octomap::OcTree& map = composer_.Compose();
+  const octomap::OcTree& map = composer.Compose();
   mapping::WriteOctreeBt(map, log_stem_ + ".bt");
   mapping::WriteOctreeOt(map, log_stem_ + ".ot");
-  mapping::WritePly(composer_.ComposedCloud(), log_stem_ + ".ply");
+  mapping::WritePly(composer.ComposedCloud(), log_stem_ + ".ply");
+  composed_submaps_ = composer.Stats().submaps;
 }
 
 }  // namespace rover::mapd

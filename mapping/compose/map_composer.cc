@@ -111,6 +111,12 @@ void MapComposer::SetSubmap(uint32_t submap_id, std::shared_ptr<const octomap::O
   // Here rather than halfway through a rebuild, which would then fail on
   // every call.
   CheckLeafSpans(*octree, ("MapComposer::SetSubmap: " + IdText(submap_id)).c_str());
+  if (stats_.released_submaps > 0 && !tree_cache_.merged_origins.empty() &&
+      submap_id <= tree_cache_.merged_origins.rbegin()->first) {
+    throw std::logic_error("MapComposer::SetSubmap: " + IdText(submap_id) +
+                           " would need a rebuild (at or below a merged id), but submaps "
+                           "were released by MergeAndRelease()");
+  }
   MarkReplaced(&tree_cache_, submap_id);
   MarkReplaced(&cloud_cache_, submap_id);
   submaps_[submap_id] = Submap{std::move(octree), std::move(cloud), T_world_submap};
@@ -129,14 +135,20 @@ void MapComposer::SetOrigin(uint32_t submap_id, const Eigen::Isometry3d& T_world
     throw std::out_of_range("MapComposer::SetOrigin: unknown " + IdText(submap_id));
   }
   CheckFinite(T_world_submap, "MapComposer::SetOrigin", submap_id);
-  it->second.T_world_submap = T_world_submap;
-  for (CacheState* cache : {&tree_cache_, &cloud_cache_}) {
-    auto merged = cache->merged_origins.find(submap_id);
-    if (merged != cache->merged_origins.end() &&
-        MovedBeyondThreshold(merged->second, T_world_submap)) {
-      cache->dirty = true;
-    }
+  bool moves[2] = {false, false};
+  CacheState* caches[2] = {&tree_cache_, &cloud_cache_};
+  for (int i = 0; i < 2; ++i) {
+    const auto merged = caches[i]->merged_origins.find(submap_id);
+    moves[i] = merged != caches[i]->merged_origins.end() &&
+               MovedBeyondThreshold(merged->second, T_world_submap);
   }
+  if (it->second.released && (moves[0] || moves[1])) {
+    throw std::logic_error("MapComposer::SetOrigin: " + IdText(submap_id) +
+                           " was released by MergeAndRelease() and cannot move beyond the "
+                           "recompose thresholds");
+  }
+  it->second.T_world_submap = T_world_submap;
+  for (int i = 0; i < 2; ++i) caches[i]->dirty = caches[i]->dirty || moves[i];
 }
 
 const Eigen::Isometry3d& MapComposer::Origin(uint32_t submap_id) const {
@@ -170,7 +182,18 @@ void MapComposer::RecordMergeStats(const OctreeMergeStats& merge) {
   stats_.out_of_range_leaves += merge.out_of_range_leaves;
 }
 
+void MapComposer::CheckRebuildable(const char* function) const {
+  if (stats_.released_submaps == 0) return;
+  for (const auto& [id, submap] : submaps_) {
+    if (submap.released) {
+      throw std::logic_error(std::string(function) + ": a rebuild needs " + IdText(id) +
+                             ", released by MergeAndRelease()");
+    }
+  }
+}
+
 void MapComposer::RebuildTree() {
+  CheckRebuildable("MapComposer::Compose");
   current_undo_.clear();
   tree_.clear();
   tree_cache_.merged_origins.clear();
@@ -199,8 +222,7 @@ void MapComposer::AppendTree() {
   }
 }
 
-const octomap::OcTree& MapComposer::Compose(const CurrentSubmap* current) {
-  const Clock::time_point start = Clock::now();
+void MapComposer::UpdateTree() {
   // A first composition is a rebuild too: lazy merging is faster for many.
   if (tree_cache_.dirty || (tree_cache_.merged_origins.empty() && !submaps_.empty())) {
     RebuildTree();
@@ -209,6 +231,11 @@ const octomap::OcTree& MapComposer::Compose(const CurrentSubmap* current) {
     UndoMerge(&current_undo_, &tree_);
     AppendTree();
   }
+}
+
+const octomap::OcTree& MapComposer::Compose(const CurrentSubmap* current) {
+  const Clock::time_point start = Clock::now();
+  UpdateTree();
   if (current != nullptr && current->octree != nullptr) {
     RecordMergeStats(MergeOctree(*current->octree, current->T_world_submap,
                                  /*lazy_eval=*/false, &tree_, &current_undo_));
@@ -242,6 +269,7 @@ void MapComposer::AddCloudToCache(const PointCloud& cloud,
 }
 
 void MapComposer::RebuildCloud() {
+  CheckRebuildable("MapComposer::ComposedCloud");
   cloud_voxels_.clear();
   cloud_index_.clear();
   cloud_points_.clear();
@@ -262,13 +290,29 @@ void MapComposer::AppendCloud() {
   }
 }
 
-PointCloud MapComposer::ComposedCloud(const CurrentSubmap* current) {
-  const Clock::time_point start = Clock::now();
+void MapComposer::UpdateCloud() {
   if (cloud_cache_.dirty || (cloud_cache_.merged_origins.empty() && !submaps_.empty())) {
     RebuildCloud();
   } else {
     AppendCloud();
   }
+}
+
+void MapComposer::MergeAndRelease() {
+  UpdateTree();
+  UpdateCloud();
+  for (auto& [id, submap] : submaps_) {
+    if (submap.released) continue;
+    submap.octree.reset();
+    submap.cloud.reset();
+    submap.released = true;
+    ++stats_.released_submaps;
+  }
+}
+
+PointCloud MapComposer::ComposedCloud(const CurrentSubmap* current) {
+  const Clock::time_point start = Clock::now();
+  UpdateCloud();
   const PointCloud* current_cloud =
       current != nullptr && current->cloud != nullptr ? current->cloud : nullptr;
   PointCloud out;

@@ -83,8 +83,10 @@ struct MapComposerStats {
   /// The same for the point cloud cache and ComposedCloud().
   uint64_t cloud_recompositions = 0;
   double last_cloud_ms = 0.0;
-  /// Finished submaps held.
+  /// Finished submaps held (released ones included).
   std::size_t submaps = 0;
+  /// Of those, released by MergeAndRelease(): only their origin is held.
+  std::size_t released_submaps = 0;
   /// Leaves of the composed octree as last returned by Compose().
   std::size_t composed_leaves = 0;
   /// Approximate memory of the composed octree and the cloud cache.
@@ -142,6 +144,16 @@ class MapComposer {
   /// order, current last).
   PointCloud ComposedCloud(const CurrentSubmap* current = nullptr);
 
+  /// Merges every submap set so far into the cached octree and point cloud
+  /// and drops the composer's share of their data, keeping only their
+  /// origins. This composes submaps whose origins are final (a finished
+  /// log) in one pass, in memory that grows with the map's extent rather
+  /// than with the number of submaps. A released submap cannot be merged
+  /// again: SetOrigin() moving one beyond the recompose thresholds, or
+  /// SetSubmap() with an id at or below a merged one, then throws
+  /// std::logic_error naming the id.
+  void MergeAndRelease();
+
   /// Counters and sizes; counting leaves walks the tree (O(map)).
   MapComposerStats Stats() const;
 
@@ -153,6 +165,7 @@ class MapComposer {
     std::shared_ptr<const octomap::OcTree> octree;
     std::shared_ptr<const PointCloud> cloud;
     Eigen::Isometry3d T_world_submap = Eigen::Isometry3d::Identity();
+    bool released = false;  ///< data dropped by MergeAndRelease()
   };
 
   // What one cache (octree or cloud) holds: each merged submap's origin at
@@ -188,6 +201,12 @@ class MapComposer {
   void RebuildTree();
   void AppendTree();
   void RecordMergeStats(const OctreeMergeStats& merge);
+
+  // Brings a cache up to date with the finished submaps (rebuild or append).
+  void UpdateTree();
+  void UpdateCloud();
+  // Throws std::logic_error if a rebuild would need a released submap.
+  void CheckRebuildable(const char* function) const;
 
   void RebuildCloud();
   void AppendCloud();

@@ -1,5 +1,8 @@
 #include "mapping/compose/submap_log.h"
 
+#include <deque>
+#include <optional>
+#include <set>
 #include <stdexcept>
 
 #include "core/geometry/yaw.h"
@@ -43,34 +46,100 @@ Eigen::Isometry3d SwitchTransform(const log::rover_msgs::EstimatorFrameSwitch& s
 
 }  // namespace
 
-SubmapLog ReadSubmapLog(const std::string& path) {
+namespace {
+
+// The parts of the submaps read so far whose three messages have not all
+// arrived; a submap is ready as soon as they have. Ready submaps are handed
+// on outside the message decoding, so that what the callback throws is not
+// taken for a bad message.
+class PendingSubmaps {
+ public:
+  void AddInfo(const log::rover_msgs::SubmapInfo& info) {
+    const HeaderKey key = KeyOf(info.header);
+    Part& part = parts_[key];
+    if (part.info) return;  // a repeated info: the first one counts
+    part.info = info;
+    info_order_.push_back(key);
+    MoveIfComplete(key);
+  }
+  void AddOctree(const HeaderKey& key, std::shared_ptr<const octomap::OcTree> octree) {
+    parts_[key].octree = std::move(octree);
+    MoveIfComplete(key);
+  }
+  void AddCloud(const HeaderKey& key, std::shared_ptr<const PointCloud> cloud) {
+    parts_[key].cloud = std::move(cloud);
+    MoveIfComplete(key);
+  }
+  void HandOn(const std::function<void(LoggedSubmap&&)>& on_submap) {
+    while (!ready_.empty()) {
+      LoggedSubmap submap = std::move(ready_.front());
+      ready_.pop_front();
+      on_submap(std::move(submap));
+    }
+  }
+  // A problem per submap left incomplete, in the order their info came;
+  // parts that never got an info are not submaps and are not reported.
+  void ReportIncomplete(std::vector<std::string>* problems) const {
+    for (const HeaderKey& key : info_order_) {
+      const auto it = parts_.find(key);
+      if (it == parts_.end() || done_.count(key)) continue;
+      problems->push_back("submap " + std::to_string(it->second.info->index) + " (" +
+                          key.frame_id + "): its " + (it->second.octree ? "cloud" : "octree") +
+                          " message is missing");
+    }
+  }
+
+ private:
+  struct Part {
+    std::optional<log::rover_msgs::SubmapInfo> info;
+    std::shared_ptr<const octomap::OcTree> octree;
+    std::shared_ptr<const PointCloud> cloud;
+  };
+  void MoveIfComplete(const HeaderKey& key) {
+    const auto it = parts_.find(key);
+    Part& part = it->second;
+    if (done_.count(key)) {  // a repeated message of a submap already out
+      parts_.erase(it);
+      return;
+    }
+    if (!part.info || !part.octree || !part.cloud) return;
+    ready_.push_back(LoggedSubmap{*part.info, std::move(part.octree), std::move(part.cloud)});
+    done_.insert(key);
+    parts_.erase(it);
+  }
+
+  std::map<HeaderKey, Part> parts_;
+  std::set<HeaderKey> done_;
+  std::vector<HeaderKey> info_order_;
+  std::deque<LoggedSubmap> ready_;
+};
+
+}  // namespace
+
+SubmapLog ForEachLoggedSubmap(const std::string& path,
+                              const std::function<void(LoggedSubmap&&)>& on_submap) {
   log::McapReader reader = OpenLog(path);
   std::map<uint16_t, std::string> topics;
   for (const auto& [id, channel] : reader.channels()) topics[id] = channel.topic;
   SubmapLog out;
-  std::map<HeaderKey, log::rover_msgs::SubmapInfo> infos;
-  std::map<HeaderKey, std::shared_ptr<const octomap::OcTree>> trees;
-  std::map<HeaderKey, std::shared_ptr<const PointCloud>> clouds;
-  std::vector<HeaderKey> order;
+  PendingSubmaps pending;
   reader.ForEachMessage([&](const log::MessageView& m) {
     const std::string& topic = topics[m.channel_id];
     std::string error;
     try {
       if (topic == kSubmapInfoTopic) {
         log::rover_msgs::SubmapInfo info;
-        if (log::DeserializeMessage(m.data, &info, &error)) {
-          const HeaderKey key = KeyOf(info.header);
-          if (infos.emplace(key, info).second) order.push_back(key);
-        }
+        if (log::DeserializeMessage(m.data, &info, &error)) pending.AddInfo(info);
       } else if (topic == kSubmapOctomapTopic) {
         log::octomap_msgs::Octomap msg;
         if (log::DeserializeMessage(m.data, &msg, &error)) {
-          trees[KeyOf(msg.header)] = FromOctomapMsg(msg);
+          pending.AddOctree(KeyOf(msg.header), FromOctomapMsg(msg));
         }
       } else if (topic == kSubmapCloudTopic) {
         log::sensor_msgs::PointCloud2 msg;
         if (log::DeserializeMessage(m.data, &msg, &error)) {
-          clouds[KeyOf(msg.header)] = std::make_shared<const PointCloud>(FromPointCloud2(msg));
+          pending.AddCloud(KeyOf(msg.header),
+                           std::make_shared<const PointCloud>(FromPointCloud2(msg)));
         }
       } else if (topic == kTraversabilityTopic) {
         ++out.traversability_grids;
@@ -79,29 +148,24 @@ SubmapLog ReadSubmapLog(const std::string& path) {
       error = e.what();
     }
     if (!error.empty()) out.problems.push_back(Where(topic, m.log_time) + ": " + error);
+    pending.HandOn(on_submap);
     return true;
   });
   for (const log::Damage& d : reader.damage()) {
     out.problems.push_back(path + ": damaged at byte " + std::to_string(d.offset) + ": " + d.what);
   }
-  for (const HeaderKey& key : order) {
-    LoggedSubmap s;
-    s.info = infos[key];
-    const auto tree = trees.find(key);
-    const auto cloud = clouds.find(key);
-    if (tree == trees.end() || cloud == clouds.end()) {
-      out.problems.push_back("submap " + std::to_string(s.info.index) + " (" + key.frame_id +
-                             "): its " + (tree == trees.end() ? "octree" : "cloud") +
-                             " message is missing");
-      continue;
-    }
-    s.octree = tree->second;
-    s.cloud = cloud->second;
-    out.submaps.push_back(std::move(s));
-  }
+  pending.ReportIncomplete(&out.problems);
   for (const log::Metadata& m : reader.metadata()) {
     if (m.name == "mapd_statistics") out.statistics = m.metadata;
   }
+  return out;
+}
+
+SubmapLog ReadSubmapLog(const std::string& path) {
+  std::vector<LoggedSubmap> submaps;
+  SubmapLog out = ForEachLoggedSubmap(
+      path, [&](LoggedSubmap&& submap) { submaps.push_back(std::move(submap)); });
+  out.submaps = std::move(submaps);
   return out;
 }
 

@@ -9,6 +9,7 @@
 // restarted, so submaps of several mapd logs land in one frame.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -53,6 +54,16 @@ struct SubmapLog {
 /// a readable MCAP file; damage inside it (a truncated tail, a bad chunk)
 /// ends up in `problems`, with every intact submap still read.
 SubmapLog ReadSubmapLog(const std::string& path);
+
+/// Reads a mapd log one submap at a time: `on_submap` gets each submap as
+/// soon as its info, octree and cloud have been read, in that order of
+/// completion (mapd writes the three together, so this is the order it
+/// built them). Memory holds the submaps whose messages are still
+/// incomplete, not the log. Returns the rest of what the log holds
+/// (`submaps` left empty); errors as ReadSubmapLog, and an exception thrown
+/// by `on_submap` ends the reading and propagates.
+SubmapLog ForEachLoggedSubmap(const std::string& path,
+                              const std::function<void(LoggedSubmap&&)>& on_submap);
 
 /// T_frame0_frame for every local frame of roverd's log, chained from its
 /// rover_msgs/EstimatorFrameSwitch records (frame 0 maps to identity).

@@ -409,16 +409,7 @@ class RoverGraph::Impl {
     if (!stats.converged && options_.incremental_steps == 0) return Solve(out);
     refine_due_ = !stats.converged;
     refine_steps_ = 0;
-    CopySolverEstimates();
-    out.solve_time_s = Seconds(start);
-    out.iterations = stats.iterations;
-    out.initial_cost = last_cost_;
-    out.final_cost = last_cost_ = solver_->LinearizedCost();
-    out.converged = stats.converged;
-    out.solved = true;
-    out.incremental_solve = true;
-    out.relinearized = stats.relinearized_variables;
-    out.refactored_columns = stats.refactored_columns;
+    AcceptIncrementalStep(stats, solver_->LinearizedCost(), start, &out);
     out.reordered = stats.reordered;
     out.variables = static_cast<int>(variables_.size());
     out.factors = static_cast<int>(factors_.size());
@@ -477,17 +468,24 @@ class RoverGraph::Impl {
       // and the swinging estimate is never published.
       return Solve(out);
     }
-    CopySolverEstimates();
-    out.solve_time_s = Seconds(start);
-    out.iterations = stats.iterations;
-    out.initial_cost = last_cost_;
-    out.final_cost = last_cost_ = cost;
-    out.converged = stats.converged;
-    out.solved = true;
-    out.incremental_solve = true;
-    out.relinearized = stats.relinearized_variables;
-    out.refactored_columns = stats.refactored_columns;
+    AcceptIncrementalStep(stats, cost, start, &out);
     return out;
+  }
+
+  // An incremental step that stands: its estimates become the graph's, and
+  // the summary says what it did.
+  void AcceptIncrementalStep(const IncrementalPoseSolverStats& stats, double cost,
+                             Clock::time_point start, RoverGraphSummary* out) {
+    CopySolverEstimates();
+    out->solve_time_s = Seconds(start);
+    out->iterations = stats.iterations;
+    out->initial_cost = last_cost_;
+    out->final_cost = last_cost_ = cost;
+    out->converged = stats.converged;
+    out->solved = true;
+    out->incremental_solve = true;
+    out->relinearized = stats.relinearized_variables;
+    out->refactored_columns = stats.refactored_columns;
   }
 
   RoverGraphSummary Solve(RoverGraphSummary out) {

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <map>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
+#include <type_traits>
 
 #include "mapping/loop/line_spread.h"
 #include "mapping/loop/option_checks.h"
@@ -14,6 +16,80 @@
 
 namespace rover::mapping {
 namespace {
+
+// Spill bytes (Serialize/Deserialize): flat values and vectors of them,
+// each vector prefixed by its element count. Eigen's fixed-size vectors are
+// plain arrays of their scalars, though the standard does not call them
+// trivially copyable.
+template <typename T>
+constexpr bool kFlat = std::is_trivially_copyable_v<T>;
+template <>
+constexpr bool kFlat<Eigen::Vector3f> = sizeof(Eigen::Vector3f) == 3 * sizeof(float);
+template <>
+constexpr bool kFlat<Eigen::Vector2d> = sizeof(Eigen::Vector2d) == 2 * sizeof(double);
+
+class SpillWriter {
+ public:
+  template <typename T>
+  void Value(const T& v) {
+    static_assert(kFlat<T>);
+    out_.append(reinterpret_cast<const char*>(&v), sizeof(T));
+  }
+  template <typename T>
+  void Vector(const std::vector<T>& v) {
+    static_assert(kFlat<T>);
+    Value(static_cast<uint64_t>(v.size()));
+    out_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+  std::string Take() { return std::move(out_); }
+
+ private:
+  std::string out_;
+};
+
+class SpillReader {
+ public:
+  explicit SpillReader(std::string_view bytes) : bytes_(bytes) {}
+  template <typename T>
+  void Value(const char* field, T* v) {
+    static_assert(kFlat<T>);
+    Need(field, sizeof(T));
+    std::memcpy(static_cast<void*>(v), bytes_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+  }
+  template <typename T>
+  void Vector(const char* field, std::vector<T>* v) {
+    uint64_t n = 0;
+    Value(field, &n);
+    if (n > (bytes_.size() - pos_) / sizeof(T)) Short(field, n * sizeof(T));
+    v->resize(n);
+    if (n == 0) return;  // data() may be null, which memcpy must not get
+    std::memcpy(static_cast<void*>(v->data()), bytes_.data() + pos_, n * sizeof(T));
+    pos_ += n * sizeof(T);
+  }
+  void ExpectEnd() const {
+    if (pos_ != bytes_.size()) {
+      throw std::runtime_error("SubmapMatchData::Deserialize: " +
+                               std::to_string(bytes_.size() - pos_) +
+                               " bytes after the last field, expected none");
+    }
+  }
+
+ private:
+  void Need(const char* field, std::size_t n) const {
+    if (n > bytes_.size() - pos_) Short(field, n);
+  }
+  [[noreturn]] void Short(const char* field, uint64_t n) const {
+    throw std::runtime_error("SubmapMatchData::Deserialize: " + std::string(field) + " needs " +
+                             std::to_string(n) + " bytes at offset " + std::to_string(pos_) +
+                             ", found " + std::to_string(bytes_.size() - pos_));
+  }
+  std::string_view bytes_;
+  std::size_t pos_ = 0;
+};
+
+constexpr uint32_t kSpillMagic = 0x31444d52;  // "RMD1"
+
 
 using loop_internal::CheckPositive;
 using loop_internal::CheckRange;
@@ -329,6 +405,115 @@ SubmapMatchData::SubmapMatchData(const PointCloud& cloud, const octomap::OcTree&
     reason_ = "suitable: " + why.str();
   }
   build_ms_ = MsSince(t0);
+}
+
+std::string SubmapMatchData::Serialize() const {
+  SpillWriter w;
+  w.Value(kSpillMagic);
+  w.Value(static_cast<int32_t>(suitability_));
+  w.Vector(std::vector<char>(reason_.begin(), reason_.end()));
+  w.Vector(keypoints_);
+  const Eigen::MatrixXf& d = descriptors_.descriptors();
+  w.Value(static_cast<int64_t>(d.rows()));
+  w.Value(static_cast<int64_t>(d.cols()));
+  w.Vector(std::vector<float>(d.data(), d.data() + d.size()));
+  w.Vector(yaw_reference_rad_);
+  w.Vector(yaw_reference_strength_);
+  w.Vector(cloud_.points());
+  w.Vector(normals_);
+  w.Vector(obstacle_);
+  w.Vector(icp_points_);
+  w.Vector(icp_normals_);
+  w.Vector(icp_obstacle_);
+  w.Value(obstacle_box_xy_.min().eval());
+  w.Value(obstacle_box_xy_.max().eval());
+  for (const int count : {obstacle_points_, keypoints_before_filter_, keypoints_dropped_unknown_,
+                          keypoints_dropped_support_, keypoints_off_line_}) {
+    w.Value(static_cast<int32_t>(count));
+  }
+  w.Value(build_ms_);
+  return w.Take();
+}
+
+std::shared_ptr<const SubmapMatchData> SubmapMatchData::Deserialize(
+    std::string_view bytes, const SubmapMatchDataOptions& options) {
+  std::shared_ptr<SubmapMatchData> data(new SubmapMatchData());
+  SubmapMatchData& m = *data;
+  m.options_ = options;
+  SpillReader r(bytes);
+  uint32_t magic = 0;
+  r.Value("magic", &magic);
+  if (magic != kSpillMagic) {
+    throw std::runtime_error("SubmapMatchData::Deserialize: not match data (bad magic number)");
+  }
+  int32_t suitability = 0;
+  r.Value("suitability", &suitability);
+  if (suitability < 0 || suitability > static_cast<int32_t>(SubmapSuitability::kKeypointsOnALine)) {
+    throw std::runtime_error("SubmapMatchData::Deserialize: suitability " +
+                             std::to_string(suitability) + " is not one of the enum's");
+  }
+  m.suitability_ = static_cast<SubmapSuitability>(suitability);
+  std::vector<char> reason;
+  r.Vector("reason", &reason);
+  m.reason_.assign(reason.begin(), reason.end());
+  r.Vector("keypoints", &m.keypoints_);
+  int64_t rows = 0;
+  int64_t cols = 0;
+  r.Value("descriptor rows", &rows);
+  r.Value("descriptor cols", &cols);
+  std::vector<float> values;
+  r.Vector("descriptors", &values);
+  if (rows < 0 || cols < 0 || static_cast<uint64_t>(rows) * static_cast<uint64_t>(cols) !=
+                                  values.size()) {
+    throw std::runtime_error("SubmapMatchData::Deserialize: " + std::to_string(values.size()) +
+                             " descriptor values for " + std::to_string(rows) + " x " +
+                             std::to_string(cols));
+  }
+  r.Vector("yaw references", &m.yaw_reference_rad_);
+  r.Vector("yaw strengths", &m.yaw_reference_strength_);
+  std::vector<Eigen::Vector3f> points;
+  r.Vector("cloud", &points);
+  r.Vector("normals", &m.normals_);
+  r.Vector("obstacle flags", &m.obstacle_);
+  r.Vector("ICP points", &m.icp_points_);
+  r.Vector("ICP normals", &m.icp_normals_);
+  r.Vector("ICP obstacle flags", &m.icp_obstacle_);
+  Eigen::Vector2d box_min;
+  Eigen::Vector2d box_max;
+  r.Value("box min", &box_min);
+  r.Value("box max", &box_max);
+  m.obstacle_box_xy_ = Eigen::AlignedBox2d(box_min, box_max);
+  for (int* count : {&m.obstacle_points_, &m.keypoints_before_filter_,
+                     &m.keypoints_dropped_unknown_, &m.keypoints_dropped_support_,
+                     &m.keypoints_off_line_}) {
+    int32_t value = 0;
+    r.Value("counts", &value);
+    *count = value;
+  }
+  r.Value("build time", &m.build_ms_);
+  r.ExpectEnd();
+  const std::size_t n = points.size();
+  const bool consistent =
+      m.obstacle_.size() == n && (m.normals_.empty() || m.normals_.size() == n) &&
+      m.icp_normals_.size() == m.icp_points_.size() &&
+      m.icp_obstacle_.size() == m.icp_points_.size() &&
+      m.yaw_reference_rad_.size() == m.keypoints_.size() &&
+      m.yaw_reference_strength_.size() == m.keypoints_.size() &&
+      (rows == 0 || static_cast<std::size_t>(rows) == m.keypoints_.size());
+  if (!consistent) {
+    throw std::runtime_error(
+        "SubmapMatchData::Deserialize: field sizes disagree (" + std::to_string(n) + " points, " +
+        std::to_string(m.obstacle_.size()) + " obstacle flags, " +
+        std::to_string(m.normals_.size()) + " normals, " + std::to_string(m.keypoints_.size()) +
+        " keypoints, " + std::to_string(rows) + " descriptors)");
+  }
+  m.cloud_ = PointKdTree(std::move(points));
+  if (rows > 0 || cols > 0) {
+    m.descriptors_ =
+        DescriptorIndex(Eigen::Map<const Eigen::MatrixXf>(values.data(), rows, cols),
+                        options.descriptor_search);
+  }
+  return data;
 }
 
 std::shared_ptr<const SubmapMatchData> SubmapMatchData::Build(

@@ -35,6 +35,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <octomap/OcTree.h>
@@ -112,6 +113,17 @@ class SubmapMatchData {
                                                       const octomap::OcTree& octree,
                                                       const SubmapMatchDataOptions& options);
 
+  /// Everything but the options as bytes, for a spill file that the same
+  /// build reads back (native byte order, no version: not an exchange
+  /// format). The k-d trees are not stored; Deserialize rebuilds them, and
+  /// as they keep the points' order, matches against the copy are the same.
+  std::string Serialize() const;
+  /// Reads what Serialize() wrote; `options` must be those the data were
+  /// built with. Throws std::runtime_error saying what is wrong with a
+  /// short, long or inconsistent `bytes`.
+  static std::shared_ptr<const SubmapMatchData> Deserialize(std::string_view bytes,
+                                                            const SubmapMatchDataOptions& options);
+
   bool suitable() const { return suitability_ == SubmapSuitability::kSuitable; }
   SubmapSuitability suitability() const { return suitability_; }
   /// Human-readable verdict with the counts behind it.
@@ -152,6 +164,8 @@ class SubmapMatchData {
   const SubmapMatchDataOptions& options() const { return options_; }
 
  private:
+  SubmapMatchData() = default;  // Deserialize fills it
+
   SubmapMatchDataOptions options_;
   SubmapSuitability suitability_ = SubmapSuitability::kSuitable;
   std::string reason_;

@@ -2,8 +2,9 @@
 // rocks on sloped ground, stereo noise growing with range): a revisit is
 // matched once its origin estimate is known and found close to the truth
 // despite the drift in the estimates, successive and far-apart submaps are
-// never paired, a submap without structure is counted as unsuitable, and
-// stopping with work queued returns.
+// never paired, match data spilled to disk and read back give the same
+// match, a submap without structure is counted as unsuitable, and stopping
+// with work queued returns.
 
 #include "firmware/mapd/loop_closer.h"
 
@@ -12,8 +13,12 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "tests/mapping/loop/loop_test_scene.h"
+#include "tests/support/temp_dir.h"
 
 namespace rover::mapd {
 namespace {
@@ -135,6 +140,36 @@ TEST_F(LoopCloserTest, ARevisitIsMatchedNearTheTruthOnceItsOriginIsKnown) {
   EXPECT_TRUE(closer.TakeMatches().empty());
 }
 
+TEST_F(LoopCloserTest, MatchDataSpilledToDiskGiveTheSameMatchAsInMemory) {
+  std::vector<std::shared_ptr<const mapping::Submap>> submaps;
+  for (uint32_t frame : {1u, 2u, 3u}) submaps.push_back(Take(Render(frame)));
+  auto run = [&](int resident, const std::string& directory) {
+    LoopCloserOptions options;
+    options.store.resident_submaps = resident;
+    options.store.spill_directory = directory;
+    LoopCloser closer(options, 0);
+    for (const auto& submap : submaps) closer.AddSubmap(submap);
+    closer.Flush();  // every submap's data made, the older ones spilled
+    closer.UpdateOrigins(DriftedOrigins());
+    closer.Flush();
+    return std::pair(closer.TakeMatches(), closer.Stats());
+  };
+  rover::testing::TempDir dir;
+  const auto [in_memory, memory_stats] = run(0, "");
+  const auto [spilled, spill_stats] = run(1, dir.path().string());
+  EXPECT_EQ(memory_stats.store.spill_writes, 0u);
+  EXPECT_GT(spill_stats.store.spill_writes, 0u);
+  EXPECT_GT(spill_stats.store.spill_reads, 0u) << "the revisit's pair was not read back";
+  EXPECT_LE(spill_stats.store.resident, 1u);
+  ASSERT_EQ(in_memory.size(), 1u);
+  ASSERT_EQ(spilled.size(), 1u);
+  EXPECT_EQ(spilled[0].a, in_memory[0].a);
+  EXPECT_EQ(spilled[0].b, in_memory[0].b);
+  EXPECT_EQ(spilled[0].accepted, in_memory[0].accepted);
+  EXPECT_EQ(spilled[0].T_a_b.matrix(), in_memory[0].T_a_b.matrix());
+  EXPECT_EQ(spilled[0].inliers, in_memory[0].inliers);
+}
+
 TEST_F(LoopCloserTest, ASubmapWithoutStructureIsCountedAndNeverPaired) {
   LoopWorld flat;  // sloped ground, no rock
   SyntheticSubmap first = Drive(flat, {0.0, 0.0}, 0.0, 21, 1);
@@ -191,8 +226,12 @@ TEST(LoopCloserOptionsTest, InvalidOptionsNameTheKey) {
   o.matcher.min_sigma_m = -1.0;
   EXPECT_THROW(LoopCloser(o, 0), std::invalid_argument);
   const ConfigNode node = ConfigNode::LoadString(
-      "max_queued_pairs: 4\nnice_increment: 5\nmatcher: {mode: six_dof}\n", "test");
+      "max_queued_pairs: 4\nnice_increment: 5\nmatcher: {mode: six_dof}\n"
+      "store: {resident_submaps: 7, spill_directory: /var/log/rover}\n",
+      "test");
   const LoopCloserOptions loaded = LoopCloserOptions::Load(node);
+  EXPECT_EQ(loaded.store.resident_submaps, 7);
+  EXPECT_EQ(loaded.store.spill_directory, "/var/log/rover");
   EXPECT_EQ(loaded.max_queued_pairs, 4);
   EXPECT_EQ(loaded.nice_increment, 5);
   EXPECT_EQ(loaded.matcher.mode, mapping::MatchMode::kSixDof);

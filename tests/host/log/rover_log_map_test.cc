@@ -82,7 +82,7 @@ class MapdLogWriter {
     cloud_ = AddChannel<log::sensor_msgs::PointCloud2>(&writer_, mapping::kSubmapCloudTopic);
   }
 
-  void Add(const TestSubmap& s) {
+  void Add(const TestSubmap& s, bool with_cloud = true) {
     const int64_t t = 1'000'000'000 + int64_t{s.index} * 1'000'000'000;
     log::std_msgs::Header header;
     header.stamp = log::ToRosTime(Time::FromNanoseconds(t));
@@ -110,7 +110,9 @@ class MapdLogWriter {
     const uint64_t time = static_cast<uint64_t>(t);
     writer_.WriteMessage(info_, sequence_++, time, time, log::SerializeMessage(info));
     writer_.WriteMessage(octomap_, sequence_++, time, time, log::SerializeMessage(octomap));
-    writer_.WriteMessage(cloud_, sequence_++, time, time, log::SerializeMessage(points));
+    if (with_cloud) {
+      writer_.WriteMessage(cloud_, sequence_++, time, time, log::SerializeMessage(points));
+    }
   }
 
   void Close() {
@@ -388,6 +390,42 @@ TEST_F(RoverLogMapTest, TruncatedMapdLogYieldsItsIntactSubmapsAndReportsTheDamag
   }
   EXPECT_FALSE(OccupiedAt(bt, 0.05 + 0.2 * 7, 0.05, 0.05)) << "the last submap was cut off";
   EXPECT_THAT(report, HasSubstr("submaps placed:   " + std::to_string(log.submaps.size())));
+}
+
+TEST_F(RoverLogMapTest, StreamedReadingHandsOnEachSubmapOnceCompleteAndReportsTheRest) {
+  const std::string path = File("stream.mcap");
+  MapdLogWriter writer(path);
+  for (uint32_t i = 0; i < 5; ++i) writer.Add(Submap(i, i, {{0.05 + 0.2 * i, 0.05, 0.05}}), i != 3);
+  writer.Close();
+
+  std::vector<uint32_t> seen;
+  const mapping::SubmapLog rest =
+      mapping::ForEachLoggedSubmap(path, [&](mapping::LoggedSubmap&& s) {
+        ASSERT_NE(s.octree, nullptr);
+        ASSERT_NE(s.cloud, nullptr);
+        EXPECT_TRUE(OccupiedAt(*s.octree, 0.05 + 0.2 * s.info.index, 0.05, 0.05));
+        seen.push_back(s.info.index);
+      });
+  EXPECT_EQ(seen, (std::vector<uint32_t>{0, 1, 2, 4}));
+  EXPECT_TRUE(rest.submaps.empty());
+  ASSERT_EQ(rest.problems.size(), 1u);
+  EXPECT_THAT(rest.problems[0], HasSubstr("submap 3"));
+  EXPECT_THAT(rest.problems[0], HasSubstr("cloud message is missing"));
+  EXPECT_EQ(rest.statistics.at("submaps"), "?");
+  // The whole-log reader gives the same.
+  const mapping::SubmapLog all = mapping::ReadSubmapLog(path);
+  ASSERT_EQ(all.submaps.size(), 4u);
+  EXPECT_EQ(all.submaps[3].info.index, 4u);
+  EXPECT_EQ(all.problems, rest.problems);
+
+  // What the callback throws ends the reading and is not taken for damage.
+  int calls = 0;
+  EXPECT_THROW(mapping::ForEachLoggedSubmap(path,
+                                            [&](mapping::LoggedSubmap&&) {
+                                              if (++calls == 2) throw std::logic_error("enough");
+                                            }),
+               std::logic_error);
+  EXPECT_EQ(calls, 2);
 }
 
 TEST_F(RoverLogMapTest, NonMcapFileIsExit2NamingTheFile) {

@@ -124,6 +124,55 @@ TEST(MapComposerTest, NewSubmapsAreAppendedAndReplacementsRecompose) {
   EXPECT_EQ(replaced, FinestVoxels(reference.Compose()));
 }
 
+TEST(MapComposerTest, MergeAndReleaseComposesAsAllAtOnceWithoutTheData) {
+  std::mt19937 rng(17);
+  MapComposer streamed;
+  MapComposer reference;
+  std::weak_ptr<const octomap::OcTree> first_tree;
+  for (uint32_t id = 0; id < 6; ++id) {
+    const auto tree = RandomSubmapTree(&rng, Eigen::Vector3d(0, 0, 0), 1.5);
+    auto cloud = std::make_shared<PointCloud>();
+    cloud->push_back(Point(0.1f * static_cast<float>(id), 0.0f, 0.2f, id % 2 == 0));
+    const Eigen::Isometry3d T = Pose(0.4 * id, 0.1 * id, 0, 0.3 * id);
+    reference.SetSubmap(id, tree, cloud, T);
+    streamed.SetSubmap(id, tree, cloud, T);
+    if (id == 0) first_tree = tree;
+    if (id % 2 == 1) streamed.MergeAndRelease();  // two at a time
+  }
+  // The composer holds nothing of the released submaps but their origins:
+  // only the reference composer still holds the first tree.
+  EXPECT_EQ(first_tree.use_count(), 1);
+  EXPECT_EQ(streamed.Stats().released_submaps, 6u);
+  EXPECT_EQ(streamed.Stats().submaps, 6u);
+  EXPECT_TRUE(streamed.Origin(5).isApprox(Pose(2.0, 0.5, 0, 1.5)));
+  EXPECT_EQ(FinestVoxels(streamed.Compose()), FinestVoxels(reference.Compose()));
+  const PointCloud a = streamed.ComposedCloud();
+  const PointCloud b = reference.ComposedCloud();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].p_submap_m, b[i].p_submap_m);
+    EXPECT_EQ(a[i].obstacle, b[i].obstacle);
+  }
+
+  // A released submap cannot be merged again: small moves are fine, a move
+  // that would rebuild, or an id that would, is refused naming the id.
+  streamed.SetOrigin(2, Pose(0.81, 0.2, 0, 0.6));
+  try {
+    streamed.SetOrigin(2, Pose(3.0, 0.2, 0, 0.6));
+    ADD_FAILURE() << "moving a released submap was accepted";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("submap id 2"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(streamed.SetSubmap(3, SingleVoxelTree(Eigen::Vector3d(0.05, 0.05, 0.05), 1.0f),
+                                  EmptyCloud(), Pose(0, 0, 0, 0)),
+               std::logic_error);
+  // A new id above them still appends.
+  streamed.SetSubmap(6, SingleVoxelTree(Eigen::Vector3d(0.05, 0.05, 0.05), LogOdds(0.97)),
+                     EmptyCloud(), Pose(20, 0, 0, 0));
+  const octomap::OcTree& more = streamed.Compose();
+  EXPECT_NE(more.search(20.05, 0.05, 0.05), nullptr);
+}
+
 TEST(MapComposerTest, CurrentSubmapIsMergedFreshAndNeverCached) {
   std::mt19937 rng(3);
   auto finished = RandomSubmapTree(&rng, Eigen::Vector3d(0, 0, 0), 3.0);
