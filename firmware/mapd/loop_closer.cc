@@ -1,17 +1,17 @@
 #include "firmware/mapd/loop_closer.h"
 
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <stdexcept>
+
+#include "firmware/runtime/rt/thread_priority.h"
 
 namespace rover::mapd {
 namespace {
 
-void LowerPriority(int increment) {
-  setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), increment);
+// Below mapd's main loop, and the spill file's reads and writes below the
+// log's. Raising one's own nice value cannot fail; nothing to report.
+void LowerPriority(int nice) {
+  runtime::LowerCurrentThreadPriority(nice, runtime::IoPriorityClass::kBestEffort, 7);
 }
 
 double MsSince(std::chrono::steady_clock::time_point start) {

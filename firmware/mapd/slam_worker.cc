@@ -1,12 +1,9 @@
 #include "firmware/mapd/slam_worker.h"
 
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-
 #include <chrono>
 
 #include "core/geometry/so3.h"
+#include "firmware/runtime/rt/thread_priority.h"
 
 namespace rover::mapd {
 namespace {
@@ -84,7 +81,8 @@ void SlamWorker::Stop() {
 
 void SlamWorker::Run() {
   // Below mapd's main loop: the graph may wait, the stereo pairs may not.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
+  // Raising one's own nice value cannot fail; nothing to report.
+  runtime::LowerCurrentThreadPriority(10, runtime::IoPriorityClass::kUnchanged, 0);
   std::unique_lock lock(mutex_);
   while (true) {
     // With nothing new to add, a one-step update that left the graph short

@@ -23,7 +23,7 @@
 #include "firmware/runtime/log_service/http_range.h"
 #include "firmware/runtime/log_service/log_catalog.h"
 #include "firmware/runtime/log_service/rate_limiter.h"
-#include "firmware/runtime/log_service/thread_priority.h"
+#include "firmware/runtime/rt/thread_priority.h"
 
 namespace rover::runtime {
 namespace {

@@ -22,15 +22,9 @@
 #include <string>
 
 #include "core/config/config.h"
+#include "firmware/runtime/rt/thread_priority.h"
 
 namespace rover::runtime {
-
-/// The I/O scheduling class of the service threads (ioprio_set(2)).
-enum class IoPriorityClass {
-  kUnchanged,   ///< Leave the threads' I/O priority alone.
-  kBestEffort,  ///< IOPRIO_CLASS_BE with `io_level`.
-  kIdle,        ///< IOPRIO_CLASS_IDLE: disk time only when nobody else wants it.
-};
 
 struct LogServiceOptions {
   std::string bind_address = "127.0.0.1";

@@ -1,4 +1,4 @@
-#include "firmware/runtime/log_service/thread_priority.h"
+#include "firmware/runtime/rt/thread_priority.h"
 
 #include <linux/ioprio.h>
 #include <sys/resource.h>
