@@ -1,5 +1,6 @@
 #include "firmware/mapd/mapd.h"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -490,6 +491,11 @@ void Mapd::FinishMappingSubmap() {
     if (loop_) loop_->AddSubmap(std::shared_ptr<const mapping::Submap>(std::move(mapping_submap_)));
   }
   mapping_submap_.reset();
+  // A submap's worth of memory (octree, cloud, serialised messages, the
+  // previous submap's matching temporaries) has been freed by now: hand the
+  // free pages of every malloc arena back to the system, so that mapd's
+  // footprint follows what it holds, not its peaks, over a long mission.
+  ::malloc_trim(0);
 }
 
 void Mapd::HandLatestPose() {

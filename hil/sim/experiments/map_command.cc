@@ -9,6 +9,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "core/config/config.h"
 #include "core/geometry/yaw.h"
 #include "core/log/mcap/mcap_reader.h"
 #include "core/log/msgs/estimator_msgs.h"
@@ -274,6 +275,10 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     if (options.rematch) {
       LoopReplayOptions replay;
       replay.reapply_switch_noise = options.rematch_reapply_switch_noise;
+      if (!options.rematch_loop_config.empty()) {
+        replay.loop =
+            mapd::LoopCloserOptions::Load(ConfigNode::LoadFile(options.rematch_loop_config));
+      }
       replay.true_origins = TrueOrigins(g, trajectory, mission, T_world_local0);
       const LoopReplayResult result =
           ReplayLoopClosing(g, mapping::ReadSubmapLog(path), replay, report);
@@ -504,6 +509,11 @@ Subcommand AddMapCommand(CLI::App& app) {
   cmd->add_flag("--rematch-reapply-switch-noise", options->rematch_reapply_switch_noise,
                 "with --rematch: put the logged frame switches through the default noise model "
                 "(logs written before mapd applied it)");
+  cmd->add_option("--rematch-loop-config", options->rematch_loop_config,
+                  "with --rematch: replay with the loop-closing options of this YAML file (keys "
+                  "as mapd's loop section: data, pairing, matcher, max_queued_pairs, ...), to see "
+                  "what another matcher setting would have found on the same submaps")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--true-origins", options->true_origins,
                 "diagnostic: compose the submaps at their true origins (the true body pose at "
                 "each frame switch), to separate the submaps' own quality from the origins' error");

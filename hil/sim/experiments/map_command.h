@@ -40,6 +40,10 @@ struct MapCommandOptions {
   /// Re-run loop closing offline on the logged submaps (loop_replay.h).
   bool rematch = false;
   bool rematch_reapply_switch_noise = false;
+  /// With rematch: a YAML file of loop-closing options (LoopCloserOptions
+  /// keys: data, pairing, matcher, ...) to replay with instead of mapd's
+  /// defaults; empty: the defaults.
+  std::string rematch_loop_config;
 };
 
 /// What RunMap measured (for rover-launch's RESULT line).
