@@ -237,8 +237,8 @@ void LoopCloser::QueuePairs() {
     if (!next) break;
     // Another robot's submap is not matched here; one whose data cannot
     // be read back is not matched at all (noted as a problem).
-    if (next->a.robot != robot_ || next->b.robot != robot_ ||
-        !store_.Contains(next->a.index) || !store_.Contains(next->b.index)) {
+    if (next->a.robot != robot_ || next->b.robot != robot_ || !store_.Contains(next->a.index) ||
+        !store_.Contains(next->b.index)) {
       continue;
     }
     std::shared_ptr<const mapping::SubmapMatchData> a = StoredData(next->a.index);

@@ -861,9 +861,8 @@ std::string Mapd::Summary() const {
                   static_cast<unsigned long long>(stats_.loop_closures),
                   static_cast<unsigned long long>(l.pairs_matched),
                   static_cast<unsigned long long>(l.submaps_suitable),
-                  static_cast<unsigned long long>(l.submaps), data_p50, match_p50,
-                  l.store.resident, l.store.submaps,
-                  static_cast<double>(l.store.spilled_bytes) / 1e6,
+                  static_cast<unsigned long long>(l.submaps), data_p50, match_p50, l.store.resident,
+                  l.store.submaps, static_cast<double>(l.store.spilled_bytes) / 1e6,
                   static_cast<unsigned long long>(l.store.spill_reads));
     out += text;
   }

@@ -83,8 +83,8 @@ class PendingSubmaps {
     for (const HeaderKey& key : info_order_) {
       const auto it = parts_.find(key);
       if (it == parts_.end() || done_.count(key)) continue;
-      problems->push_back("submap " + std::to_string(it->second.info->index) + " (" +
-                          key.frame_id + "): its " + (it->second.octree ? "cloud" : "octree") +
+      problems->push_back("submap " + std::to_string(it->second.info->index) + " (" + key.frame_id +
+                          "): its " + (it->second.octree ? "cloud" : "octree") +
                           " message is missing");
     }
   }

@@ -56,8 +56,8 @@ MatchDataStore::~MatchDataStore() {
 }
 
 void MatchDataStore::Put(int64_t key, std::shared_ptr<const SubmapMatchData> data) {
-  if (!data) throw std::invalid_argument("MatchDataStore::Put: null data for key " +
-                                         std::to_string(key));
+  if (!data)
+    throw std::invalid_argument("MatchDataStore::Put: null data for key " + std::to_string(key));
   Erase(key);
   Entry& entry = entries_[key];
   entry.data = std::move(data);
@@ -141,8 +141,8 @@ void MatchDataStore::Write(Entry* entry) {
   const std::string bytes = entry->data->Serialize();
   std::size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done,
-                               static_cast<off_t>(end_ + done));
+    const ssize_t n =
+        ::pwrite(fd_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(end_ + done));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       throw std::runtime_error("MatchDataStore: writing " + std::to_string(bytes.size()) +
@@ -158,8 +158,7 @@ void MatchDataStore::Write(Entry* entry) {
   ++stats_.spill_writes;
 }
 
-std::shared_ptr<const SubmapMatchData> MatchDataStore::Read(int64_t key,
-                                                            const Entry& entry) const {
+std::shared_ptr<const SubmapMatchData> MatchDataStore::Read(int64_t key, const Entry& entry) const {
   std::string bytes(entry.bytes, '\0');
   std::size_t done = 0;
   while (done < bytes.size()) {

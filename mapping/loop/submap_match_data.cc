@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -69,9 +69,9 @@ class SpillReader {
   }
   void ExpectEnd() const {
     if (pos_ != bytes_.size()) {
-      throw std::runtime_error("SubmapMatchData::Deserialize: " +
-                               std::to_string(bytes_.size() - pos_) +
-                               " bytes after the last field, expected none");
+      throw std::runtime_error(
+          "SubmapMatchData::Deserialize: " + std::to_string(bytes_.size() - pos_) +
+          " bytes after the last field, expected none");
     }
   }
 
@@ -89,7 +89,6 @@ class SpillReader {
 };
 
 constexpr uint32_t kSpillMagic = 0x31444d52;  // "RMD1"
-
 
 using loop_internal::CheckPositive;
 using loop_internal::CheckRange;
@@ -463,8 +462,8 @@ std::shared_ptr<const SubmapMatchData> SubmapMatchData::Deserialize(
   r.Value("descriptor cols", &cols);
   std::vector<float> values;
   r.Vector("descriptors", &values);
-  if (rows < 0 || cols < 0 || static_cast<uint64_t>(rows) * static_cast<uint64_t>(cols) !=
-                                  values.size()) {
+  if (rows < 0 || cols < 0 ||
+      static_cast<uint64_t>(rows) * static_cast<uint64_t>(cols) != values.size()) {
     throw std::runtime_error("SubmapMatchData::Deserialize: " + std::to_string(values.size()) +
                              " descriptor values for " + std::to_string(rows) + " x " +
                              std::to_string(cols));
@@ -483,9 +482,9 @@ std::shared_ptr<const SubmapMatchData> SubmapMatchData::Deserialize(
   r.Value("box min", &box_min);
   r.Value("box max", &box_max);
   m.obstacle_box_xy_ = Eigen::AlignedBox2d(box_min, box_max);
-  for (int* count : {&m.obstacle_points_, &m.keypoints_before_filter_,
-                     &m.keypoints_dropped_unknown_, &m.keypoints_dropped_support_,
-                     &m.keypoints_off_line_}) {
+  for (int* count :
+       {&m.obstacle_points_, &m.keypoints_before_filter_, &m.keypoints_dropped_unknown_,
+        &m.keypoints_dropped_support_, &m.keypoints_off_line_}) {
     int32_t value = 0;
     r.Value("counts", &value);
     *count = value;
@@ -493,25 +492,24 @@ std::shared_ptr<const SubmapMatchData> SubmapMatchData::Deserialize(
   r.Value("build time", &m.build_ms_);
   r.ExpectEnd();
   const std::size_t n = points.size();
-  const bool consistent =
-      m.obstacle_.size() == n && (m.normals_.empty() || m.normals_.size() == n) &&
-      m.icp_normals_.size() == m.icp_points_.size() &&
-      m.icp_obstacle_.size() == m.icp_points_.size() &&
-      m.yaw_reference_rad_.size() == m.keypoints_.size() &&
-      m.yaw_reference_strength_.size() == m.keypoints_.size() &&
-      (rows == 0 || static_cast<std::size_t>(rows) == m.keypoints_.size());
+  const bool consistent = m.obstacle_.size() == n &&
+                          (m.normals_.empty() || m.normals_.size() == n) &&
+                          m.icp_normals_.size() == m.icp_points_.size() &&
+                          m.icp_obstacle_.size() == m.icp_points_.size() &&
+                          m.yaw_reference_rad_.size() == m.keypoints_.size() &&
+                          m.yaw_reference_strength_.size() == m.keypoints_.size() &&
+                          (rows == 0 || static_cast<std::size_t>(rows) == m.keypoints_.size());
   if (!consistent) {
-    throw std::runtime_error(
-        "SubmapMatchData::Deserialize: field sizes disagree (" + std::to_string(n) + " points, " +
-        std::to_string(m.obstacle_.size()) + " obstacle flags, " +
-        std::to_string(m.normals_.size()) + " normals, " + std::to_string(m.keypoints_.size()) +
-        " keypoints, " + std::to_string(rows) + " descriptors)");
+    throw std::runtime_error("SubmapMatchData::Deserialize: field sizes disagree (" +
+                             std::to_string(n) + " points, " + std::to_string(m.obstacle_.size()) +
+                             " obstacle flags, " + std::to_string(m.normals_.size()) +
+                             " normals, " + std::to_string(m.keypoints_.size()) + " keypoints, " +
+                             std::to_string(rows) + " descriptors)");
   }
   m.cloud_ = PointKdTree(std::move(points));
   if (rows > 0 || cols > 0) {
-    m.descriptors_ =
-        DescriptorIndex(Eigen::Map<const Eigen::MatrixXf>(values.data(), rows, cols),
-                        options.descriptor_search);
+    m.descriptors_ = DescriptorIndex(Eigen::Map<const Eigen::MatrixXf>(values.data(), rows, cols),
+                                     options.descriptor_search);
   }
   return data;
 }

@@ -36,8 +36,8 @@ class MatchDataStoreTest : public ::testing::Test {
     for (const auto& [start, yaw, seed] :
          {std::tuple{Eigen::Vector2d(0.0, 0.0), 0.0, 11}, {Eigen::Vector2d(1.0, 0.5), 0.2, 12}}) {
       Drive d;
-      d.submap = testing::BuildSubmap(
-          *world_, testing::StraightDrive(*world_, start, yaw, 12, 0.5), static_cast<uint64_t>(seed));
+      d.submap = testing::BuildSubmap(*world_, testing::StraightDrive(*world_, start, yaw, 12, 0.5),
+                                      static_cast<uint64_t>(seed));
       d.data = SubmapMatchData::Build(d.submap.submap->cloud(), d.submap.submap->octree(), {});
       drives_->push_back(std::move(d));
     }
@@ -99,8 +99,7 @@ TEST_F(MatchDataStoreTest, SpilledDataReadBackGiveTheSameMatchBitForBit) {
   ExpectSameData(*At(0).data, *a);
   ExpectSameData(*At(1).data, *b);
   // The rebuilt k-d trees answer as the originals: the match is identical.
-  const Isometry3d truth =
-      At(0).submap.T_world_submap.inverse() * At(1).submap.T_world_submap;
+  const Isometry3d truth = At(0).submap.T_world_submap.inverse() * At(1).submap.T_world_submap;
   MatchPrior prior;
   prior.T_a_b = truth;
   prior.covariance = Matrix6d::Identity() * 0.25;
@@ -122,8 +121,8 @@ TEST_F(MatchDataStoreTest, UnsuitableDataRoundTripToo) {
 
 TEST_F(MatchDataStoreTest, DamagedBytesAreRefusedSayingWhat) {
   const std::string bytes = At(0).data->Serialize();
-  for (const std::size_t keep : {std::size_t{0}, std::size_t{3}, std::size_t{40},
-                                 bytes.size() / 2, bytes.size() - 1}) {
+  for (const std::size_t keep :
+       {std::size_t{0}, std::size_t{3}, std::size_t{40}, bytes.size() / 2, bytes.size() - 1}) {
     try {
       SubmapMatchData::Deserialize(std::string_view(bytes).substr(0, keep), {});
       ADD_FAILURE() << "a stream cut at " << keep << " bytes was accepted";
