@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -37,6 +38,12 @@ std::string LogStem() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A fixed mmap threshold. glibc otherwise raises it each time a mapped
+  // block is freed (up to 32 MB), after which the loop threads' megabyte
+  // match data and ICP buffers come from the malloc arenas, whose
+  // fragmentation keeps their pages: mapd's footprint then creeps up over a
+  // long mission. Fixed, blocks this large are mapped and returned whole.
+  ::mallopt(M_MMAP_THRESHOLD, 256 * 1024);
   CLI::App app{
       "mapd: the rover's mapping process. Subscribes to roverd's estimates, stereo pairs and\n"
       "frame switches over iceoryx (RouDi must run: scripts/roudi.sh start, or the rover-roudi\n"

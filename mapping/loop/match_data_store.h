@@ -31,7 +31,7 @@ namespace rover::mapping {
 struct MatchDataStoreOptions {
   /// Submaps whose data stay in memory, the most recently used; the rest
   /// go to the spill file. 0 keeps every submap's data in memory (no file).
-  int resident_submaps = 24;
+  int resident_submaps = 8;
   /// Directory of the spill file; empty: $TMPDIR, else /tmp.
   std::string spill_directory;
 
