@@ -82,7 +82,7 @@ class PendingSubmaps {
   void ReportIncomplete(std::vector<std::string>* problems) const {
     for (const HeaderKey& key : info_order_) {
       const auto it = parts_.find(key);
-      if (it == parts_.end() || done_.count(key)) continue;
+      if (it == parts_.end()) continue;  // complete, handed on
       problems->push_back("submap " + std::to_string(it->second.info->index) + " (" + key.frame_id +
                           "): its " + (it->second.octree ? "cloud" : "octree") +
                           " message is missing");

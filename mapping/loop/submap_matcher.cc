@@ -364,6 +364,7 @@ void SubmapMatcherOptions::Validate() const {
   CheckPositive(kC, "max_icp_shift_m", max_icp_shift_m);
   CheckPositive(kC, "max_icp_turn_rad", max_icp_turn_rad);
   CheckRange(kC, "max_final_tilt_rad", max_final_tilt_rad, 0.0, M_PI);
+  CheckRange(kC, "max_yaw_innovation_sigmas", max_yaw_innovation_sigmas, 0.0, 100.0);
   CheckPositive(kC, "covariance_scale", covariance_scale);
   CheckPositive(kC, "min_sigma_m", min_sigma_m);
   CheckRange(kC, "rmse_sigma_factor", rmse_sigma_factor, 0.0, 1e3);
@@ -427,6 +428,7 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
   d("max_icp_shift_m", &o.max_icp_shift_m);
   d("max_icp_turn_rad", &o.max_icp_turn_rad);
   d("max_final_tilt_rad", &o.max_final_tilt_rad);
+  d("max_yaw_innovation_sigmas", &o.max_yaw_innovation_sigmas);
   d("covariance_scale", &o.covariance_scale);
   d("min_sigma_m", &o.min_sigma_m);
   d("rmse_sigma_factor", &o.rmse_sigma_factor);
@@ -515,11 +517,26 @@ std::string FindHypothesis(const SubmapMatcherOptions& o, const SubmapMatchData&
   return {};
 }
 
+// The yaw innovation gate (SubmapMatcherOptions::max_yaw_innovation_sigmas):
+// empty when the match's yaw agrees with a bounded prior's.
+std::string YawInnovationRejection(const SubmapMatcherOptions& o, const MatchPrior& prior,
+                                   const SubmapMatchResult& r) {
+  if (!prior.bounded || o.max_yaw_innovation_sigmas <= 0.0) return {};
+  const double innovation_rad = std::abs(YawOf((prior.T_a_b.inverse() * r.T_a_b).linear()));
+  const double sigma_rad = std::sqrt(prior.covariance(5, 5) + r.covariance(5, 5));
+  const double limit_rad = o.max_yaw_innovation_sigmas * sigma_rad;
+  if (innovation_rad <= limit_rad) return {};
+  std::ostringstream text;
+  text << "yaw " << innovation_rad << " rad off the prior's > " << limit_rad << " rad ("
+       << o.max_yaw_innovation_sigmas << " sigma of " << sigma_rad << ")";
+  return text.str();
+}
+
 // Steps 4-5: ICP from r->T_a_b_initial, then the validity checks. Empty when
 // the match is accepted, else the first check that failed.
 std::string RefineAndCheck(const SubmapMatcherOptions& o, const SubmapMatchData& a,
-                           const SubmapMatchData& b, const PriorBounds& bounds,
-                           SubmapMatchResult* result) {
+                           const SubmapMatchData& b, const MatchPrior& prior,
+                           const PriorBounds& bounds, SubmapMatchResult* result) {
   SubmapMatchResult& r = *result;
   // 4. ICP.
   const Clock::time_point ts = Clock::now();
@@ -597,7 +614,7 @@ std::string RefineAndCheck(const SubmapMatcherOptions& o, const SubmapMatchData&
     }
   }
   r.covariance = MatchCovariance(r.icp, o);
-  return {};
+  return YawInnovationRejection(o, prior, r);
 }
 
 // The prior is tight enough for an ICP started from it to converge to the
@@ -643,11 +660,11 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapMatchData& a, const SubmapMat
     r.T_a_b_initial = prior.T_a_b;
     r.inliers.clear();  // of a hypothesis that failed
     r.inlier_ratio = 0.0;
-    const std::string rejection = RefineAndCheck(o, a, b, bounds, &r);
+    const std::string rejection = RefineAndCheck(o, a, b, prior, bounds, &r);
     return finish(rejection.empty() ? rejection
                                     : no_hypothesis + "; aligned from the prior: " + rejection);
   }
-  return finish(RefineAndCheck(o, a, b, bounds, &r));
+  return finish(RefineAndCheck(o, a, b, prior, bounds, &r));
 }
 
 }  // namespace rover::mapping

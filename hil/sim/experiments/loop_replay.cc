@@ -111,14 +111,18 @@ class Replay {
     ++result_.pairs_matched;
     const Eigen::Isometry3d correction = pair.prior.T_a_b.inverse() * r.T_a_b;
     const std::optional<Eigen::Isometry3d> T_true = TrueTransform(pair);
-    char line[640];
+    char line[1024];
     std::snprintf(
         line, sizeof(line),
-        "    replay: %lld-%lld %s%s, %.2f m from the graph, overlap %.2f, obstacle "
-        "agreement %.2f%s\n",
+        "    replay: %lld-%lld %s%s, %.2f m %.2f deg from the graph, overlap %.2f, obstacle "
+        "agreement %.2f, %d inliers, ICP rmse %.3f m, s^2 H^-1 sigma %.4f m %.3f deg%s\n",
         static_cast<long long>(pair.a.index), static_cast<long long>(pair.b.index),
         r.accepted ? (r.from_prior ? "accepted from the prior" : "accepted") : "rejected: ",
-        r.rejection.c_str(), correction.translation().norm(), r.overlap_ratio, r.obstacle_agreement,
+        r.rejection.c_str(), correction.translation().norm(),
+        std::abs(YawOf(correction.linear())) * 180.0 / M_PI, r.overlap_ratio, r.obstacle_agreement,
+        static_cast<int>(r.inliers.size()), r.icp.rmse_m,
+        std::sqrt(r.icp.covariance(0, 0) + r.icp.covariance(1, 1)),
+        std::sqrt(r.icp.covariance(5, 5)) * 180.0 / M_PI,
         T_true ? TruthError(pair, r, *T_true).c_str() : "");
     report_ << line;
     if (!r.accepted) return;

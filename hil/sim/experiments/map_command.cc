@@ -7,13 +7,17 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "core/config/config.h"
 #include "core/geometry/yaw.h"
 #include "core/log/mcap/mcap_reader.h"
 #include "core/log/msgs/estimator_msgs.h"
 #include "core/log/msgs/message_traits.h"
+#include "core/stats/percentile.h"
 #include "estimator/eskf/eskf_output.h"
 #include "hil/sim/dataset/dataset_generator.h"
 #include "hil/sim/experiments/loop_replay.h"
@@ -124,6 +128,21 @@ std::map<int64_t, Eigen::Isometry3d> TrueOrigins(const mapping::GraphLogContents
   return truth;
 }
 
+// Calls visit(factor, T_a_b_true) for each two-origin factor of `kind` whose
+// origins both have a known truth.
+template <typename Visit>
+void ForEachFactorWithTruth(const mapping::GraphLogContents& g,
+                            const std::map<int64_t, Eigen::Isometry3d>& truth,
+                            mapping::FactorKind kind, Visit visit) {
+  for (const mapping::GraphFactorRecord& f : g.factors) {
+    if (f.kind != kind || !f.b) continue;
+    const auto a = truth.find(f.a.index);
+    const auto b = truth.find(f.b->index);
+    if (a == truth.end() || b == truth.end()) continue;
+    visit(f, Eigen::Isometry3d(a->second.inverse() * b->second));
+  }
+}
+
 // Counts the graph's submap matches and those that hold against the true
 // origins. A match naming a frame of unknown truth counts as invalid.
 void ScoreLoopClosures(const mapping::GraphLogContents& g,
@@ -141,6 +160,66 @@ void ScoreLoopClosures(const mapping::GraphLogContents& g,
                                                    : std::numeric_limits<double>::quiet_NaN();
 }
 
+// The accepted submap matches' errors against the truth (median and p90 of
+// the translation and yaw), and a diagnostic: the constant offset d in the
+// origins' frames that best explains them. Origins (or submap content) all
+// shifted by d make a match of relative yaw R read t + (R - I) d, so a
+// consistent d with a small residual points at a bias common to every submap
+// (a stamp offset, a depth bias along the view) rather than at the matcher.
+void ReportLoopClosureErrors(const mapping::GraphLogContents& g,
+                             const std::map<int64_t, Eigen::Isometry3d>& truth,
+                             std::ostream& report) {
+  std::vector<double> translation_m, yaw_deg;
+  Eigen::Matrix2d AtA = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d Atb = Eigen::Vector2d::Zero();
+  std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>> rows;
+  std::ostringstream invalid;
+  ForEachFactorWithTruth(
+      g, truth, mapping::FactorKind::kSubmapMatch, [&](const auto& f, const auto& T_true) {
+        const Eigen::Vector3d e = f.T_a_b.translation() - T_true.translation();
+        if (!IsValidLoopClosure(f.T_a_b, T_true)) {
+          const Eigen::Matrix4d P = mapping::FourDofBlock(f.covariance);
+          invalid << " | " << f.a.index << "-" << f.b->index << " " << Num(e.norm(), 3) << " m "
+                  << Num(std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()),
+                                        2.0 * M_PI) *
+                             180.0 / M_PI,
+                         2)
+                  << " deg (sigma " << Num(std::sqrt(P(0, 0) + P(1, 1)), 3) << " m "
+                  << Num(std::sqrt(P(3, 3)) * 180.0 / M_PI, 2) << " deg)";
+        }
+        translation_m.push_back(e.norm());
+        yaw_deg.push_back(
+            std::abs(std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()), 2.0 * M_PI)) *
+            180.0 / M_PI);
+        const Eigen::Matrix2d A =
+            T_true.linear().topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity();
+        AtA += A.transpose() * A;
+        Atb += A.transpose() * e.head<2>();
+        rows.emplace_back(A, e.head<2>());
+      });
+  if (translation_m.empty()) return;
+  report << "  submap matches vs truth: " << translation_m.size() << "; translation median "
+         << Num(stats::Percentile(translation_m, 50.0), 3) << " m, p90 "
+         << Num(stats::Percentile(translation_m, 90.0), 3) << " m; yaw median "
+         << Num(stats::Percentile(yaw_deg, 50.0), 2) << " deg, p90 "
+         << Num(stats::Percentile(yaw_deg, 90.0), 2) << " deg";
+  if (AtA.determinant() > 1e-6) {
+    const Eigen::Vector2d d = AtA.ldlt().solve(Atb);
+    double before = 0.0, after = 0.0;
+    for (const auto& [A, e] : rows) {
+      before += e.squaredNorm();
+      after += (e - A * d).squaredNorm();
+    }
+    const double n = static_cast<double>(rows.size());
+    report << "; a common origin offset (x " << Num(d(0), 3) << " m, y " << Num(d(1), 3)
+           << " m) would explain xy RMS " << Num(std::sqrt(before / n), 3) << " -> "
+           << Num(std::sqrt(after / n), 3) << " m";
+  }
+  report << "\n";
+  if (!invalid.str().empty())
+    report << "  invalid matches: a-b error (sigma)" << invalid.str() << "\n";
+}
+
 // How the frame switches (w factors) hold against the truth: each switch's
 // error in its old frame (x: the heading at the frame's start, so mostly
 // along-track), normalised by the covariance the graph gives it. Consistent
@@ -152,23 +231,19 @@ void ReportFrameSwitchConsistency(const mapping::GraphLogContents& g,
   Eigen::Vector4d normalised_sq = Eigen::Vector4d::Zero();
   double nees_sum = 0.0, distance_sum_m = 0.0;
   int n = 0;
-  for (const mapping::GraphFactorRecord& f : g.factors) {
-    if (f.kind != mapping::FactorKind::kFrameSwitch || !f.b) continue;
-    const auto a = truth.find(f.a.index);
-    const auto b = truth.find(f.b->index);
-    if (a == truth.end() || b == truth.end()) continue;
-    const Eigen::Isometry3d T_true = a->second.inverse() * b->second;
-    Eigen::Vector4d e;
-    e.head<3>() = f.T_a_b.translation() - T_true.translation();
-    e(3) = std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()), 2.0 * M_PI);
-    const Eigen::Matrix4d P = mapping::FourDofBlock(f.covariance);
-    sum += e;
-    sum_sq += e.cwiseAbs2();
-    normalised_sq += e.cwiseAbs2().cwiseQuotient(P.diagonal());
-    nees_sum += e.dot(P.ldlt().solve(e));
-    distance_sum_m += T_true.translation().norm();
-    ++n;
-  }
+  ForEachFactorWithTruth(
+      g, truth, mapping::FactorKind::kFrameSwitch, [&](const auto& f, const auto& T_true) {
+        Eigen::Vector4d e;
+        e.head<3>() = f.T_a_b.translation() - T_true.translation();
+        e(3) = std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()), 2.0 * M_PI);
+        const Eigen::Matrix4d P = mapping::FourDofBlock(f.covariance);
+        sum += e;
+        sum_sq += e.cwiseAbs2();
+        normalised_sq += e.cwiseAbs2().cwiseQuotient(P.diagonal());
+        nees_sum += e.dot(P.ldlt().solve(e));
+        distance_sum_m += T_true.translation().norm();
+        ++n;
+      });
   if (n == 0) return;
   const Eigen::Vector4d mean = sum / n;
   const Eigen::Vector4d sd = (sum_sq / n - mean.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
@@ -290,6 +365,7 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     const std::map<int64_t, Eigen::Isometry3d> truth =
         TrueOrigins(g, trajectory, mission, T_world_local0);
     ScoreLoopClosures(g, truth, r);
+    ReportLoopClosureErrors(g, truth, report);
     ReportFrameSwitchConsistency(g, truth, r, report);
     ReportOriginErrors(g, truth, report);
     if (options.true_origins) {
@@ -468,6 +544,16 @@ int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& er
   }
 }
 
+void AddObstacleScoringOptions(CLI::App* cmd, MapQualityOptions* quality) {
+  cmd->add_option("--obstacle-radius-m", quality->obstacle_radius_m,
+                  "a flagged point within this of a true obstacle cell is correct")
+      ->capture_default_str();
+  cmd->add_option("--obstacle-view-range-m", quality->obstacle_view_range_m,
+                  "recall counts the true obstacles the camera saw from within this distance, "
+                  "from where stereo resolves their height above a wheel's step")
+      ->capture_default_str();
+}
+
 Subcommand AddMapCommand(CLI::App& app) {
   auto options = std::make_shared<MapCommandOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -489,13 +575,7 @@ Subcommand AddMapCommand(CLI::App& app) {
   cmd->add_option("--surface-tolerance-m", options->quality.surface_tolerance_m,
                   "an occupied voxel within this of the true surface is correct")
       ->capture_default_str();
-  cmd->add_option("--obstacle-radius-m", options->quality.obstacle_radius_m,
-                  "a flagged point within this of a true obstacle cell is correct")
-      ->capture_default_str();
-  cmd->add_option("--obstacle-view-range-m", options->quality.obstacle_view_range_m,
-                  "recall counts the true obstacles the camera saw from within this distance, "
-                  "from where stereo resolves their height above a wheel's step")
-      ->capture_default_str();
+  AddObstacleScoringOptions(cmd, &options->quality);
   cmd->add_option("--false-matches", options->false_match_fraction,
                   "also re-solve mapd's graph with this share of its submap matches false "
                   "(tempting ones: near pairs, 1-4 m and up to 29 deg off), and report the final "

@@ -95,6 +95,10 @@ int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& er
 /// Adds `rover-sim map` to `app` (see subcommand.h).
 Subcommand AddMapCommand(CLI::App& app);
 
+/// Adds --obstacle-radius-m and --obstacle-view-range-m, the obstacle
+/// scoring options shared by `rover-sim map` and `rover-sim terrain`.
+void AddObstacleScoringOptions(CLI::App* cmd, MapQualityOptions* quality);
+
 }  // namespace rover::sim::experiments
 
 #endif  // ROVER_HIL_SIM_EXPERIMENTS_MAP_COMMAND_H_

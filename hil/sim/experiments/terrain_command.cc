@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "firmware/mapd/local_mapper.h"
+#include "hil/sim/experiments/map_command.h"
 #include "hil/sim/motion/rover_trajectory.h"
 #include "hil/sim/motion/trajectory_sample.h"
 #include "hil/sim/render/stereo_camera.h"
@@ -152,13 +153,7 @@ cli::Subcommand AddTerrainCommand(CLI::App& app) {
   cmd->add_option("--max-duration-s", options->max_duration_s,
                   "map only the first S seconds of the route (0: all)")
       ->capture_default_str();
-  cmd->add_option("--obstacle-radius-m", options->quality.obstacle_radius_m,
-                  "a flagged point within this of a true obstacle cell is correct")
-      ->capture_default_str();
-  cmd->add_option("--obstacle-view-range-m", options->quality.obstacle_view_range_m,
-                  "recall counts the true obstacles the camera saw from within this distance, "
-                  "from where stereo resolves their height above a wheel's step")
-      ->capture_default_str();
+  AddObstacleScoringOptions(cmd, &options->quality);
   return {cmd, [options] { return RunTerrain(*options, std::cout, std::cerr); }};
 }
 

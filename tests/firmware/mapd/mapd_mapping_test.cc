@@ -46,6 +46,11 @@ class MapdMappingTest : public ::testing::Test {
     frames_ = transport_.MakePublisher<topics::StereoFrameMsg>(T(topics::kStereoFrameTopic));
   }
 
+  ~MapdMappingTest() override {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
+  }
+
   std::unique_ptr<Mapd> MakeMapd() {
     MapdOptions options;
     options.pose_queue = 8;

@@ -278,6 +278,31 @@ TEST_F(SubmapMatcherTest, AnIcpFromThePriorCannotLeaveItsBounds) {
   std::printf("prior 0.6 m off: %s\n", r.rejection.c_str());
 }
 
+// The yaw innovation gate, turned on (k = 3): a prior confident in the
+// relative heading (sigma 0.1 deg) but 2 deg off the truth. The keypoints
+// find the truth, inside the prior's 3 deg bounds, yet 2 deg is beyond 3
+// sigma of the difference (prior and the match's floored 0.4 deg): refused.
+// A looser prior (1 deg), or the default (gate off), accepts the same match.
+TEST_F(SubmapMatcherTest, AMatchFarInYawFromAConfidentPriorIsRefusedWithTheGate) {
+  const Isometry3d truth = Truth(0, 1);
+  SubmapMatcherOptions gated;
+  gated.max_yaw_innovation_sigmas = 3.0;
+  const SubmapMatcher matcher(gated);
+  const MatchPrior confident = PriorOff(truth, {0.05, 0.0, 0.0, 2.0 * kDeg}, 0.1, 0.1 * kDeg);
+  SubmapMatchResult r = matcher.Match(*Drive(0).data, *Drive(1).data, confident);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.rejection.find("off the prior's"), std::string::npos) << r.rejection;
+  // Refused for its yaw alone: the ICP itself found the truth.
+  EXPECT_LT(ErrorOf(r.T_a_b, truth).rotation_rad, 0.5 * kDeg);
+  std::printf("confident prior 2 deg off: %s\n", r.rejection.c_str());
+
+  const MatchPrior loose = PriorOff(truth, {0.05, 0.0, 0.0, 2.0 * kDeg}, 0.1, 1.0 * kDeg);
+  r = matcher.Match(*Drive(0).data, *Drive(1).data, loose);
+  EXPECT_TRUE(r.accepted) << r.rejection;
+  r = SubmapMatcher().Match(*Drive(0).data, *Drive(1).data, confident);
+  EXPECT_TRUE(r.accepted) << r.rejection;
+}
+
 TEST_F(SubmapMatcherTest, NonFiniteInputIsAClearError) {
   PointCloud cloud = Drive(0).submap.submap->cloud();
   cloud[5].p_submap_m.y() = NAN;
