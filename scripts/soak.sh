@@ -5,10 +5,10 @@
 # wall time to the end of the drive (roverd-sim exits), neither process's
 # RSS grew by more than MAX_GROWTH_PCT (medians of WINDOW_S seconds at each
 # end, default 300), and the mission reports no IMU or frame drops. mapd's
-# shutdown, when it composes the global map from its log
-# and exports it, is sampled too and reported on its own ("export peak"): it
-# holds the map, which grows with the ground covered, not with time. Not a
-# CI test: one lap takes about 45 minutes on a machine like the CI's.
+# shutdown, when it composes the global map from its log and exports it, is
+# sampled too and reported on its own ("export peak"): it holds the map,
+# which grows with the ground covered, not with time. Not a CI test: one lap
+# takes about 45 minutes on a machine like the CI's.
 #
 # Usage: scripts/soak.sh [--laps N] [--seed S] [--out DIR] [--period-s P]
 #   --laps N        laps of the figure-eight (default 2: about 2 km, 90 minutes)
@@ -25,6 +25,7 @@ SEED=1
 OUT=build/soak
 PERIOD_S=30
 WARMUP_S=${WARMUP_S:-600}
+WINDOW_S=${WINDOW_S:-300}
 MAX_GROWTH_PCT=${MAX_GROWTH_PCT:-5}
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -98,7 +99,7 @@ echo "$RESULT"
 # swings by a few per cent with the work in flight (a match, a submap being
 # finished), so single samples would judge the noise; the largest sample is
 # reported too.
-awk -F, -v warm="$WARMUP_S" -v max="$MAX_GROWTH_PCT" -v window="${WINDOW_S:-300}" '
+awk -F, -v warm="$WARMUP_S" -v max="$MAX_GROWTH_PCT" -v window="$WINDOW_S" '
   function median(a, n,    i, j, t) {
     for (i = 2; i <= n; i++) { t = a[i]; for (j = i - 1; j >= 1 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
     return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2

@@ -128,6 +128,11 @@ std::map<int64_t, Eigen::Isometry3d> TrueOrigins(const mapping::GraphLogContents
   return truth;
 }
 
+// Yaw of T_a_b less the true one, wrapped to [-pi, pi].
+double YawErrorRad(const Eigen::Isometry3d& T_a_b, const Eigen::Isometry3d& T_a_b_true) {
+  return std::remainder(YawOf(T_a_b.linear()) - YawOf(T_a_b_true.linear()), 2.0 * M_PI);
+}
+
 // Calls visit(factor, T_a_b_true) for each two-origin factor of `kind` whose
 // origins both have a known truth.
 template <typename Visit>
@@ -170,32 +175,24 @@ void ReportLoopClosureErrors(const mapping::GraphLogContents& g,
                              const std::map<int64_t, Eigen::Isometry3d>& truth,
                              std::ostream& report) {
   std::vector<double> translation_m, yaw_deg;
-  Eigen::Matrix2d AtA = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d Atb = Eigen::Vector2d::Zero();
+  // Per match: A = R - I (xy block) and the xy error, for the offset fit.
   std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>> rows;
   std::ostringstream invalid;
   ForEachFactorWithTruth(
       g, truth, mapping::FactorKind::kSubmapMatch, [&](const auto& f, const auto& T_true) {
         const Eigen::Vector3d e = f.T_a_b.translation() - T_true.translation();
+        const double yaw_error_deg = YawErrorRad(f.T_a_b, T_true) * 180.0 / M_PI;
         if (!IsValidLoopClosure(f.T_a_b, T_true)) {
           const Eigen::Matrix4d P = mapping::FourDofBlock(f.covariance);
           invalid << " | " << f.a.index << "-" << f.b->index << " " << Num(e.norm(), 3) << " m "
-                  << Num(std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()),
-                                        2.0 * M_PI) *
-                             180.0 / M_PI,
-                         2)
-                  << " deg (sigma " << Num(std::sqrt(P(0, 0) + P(1, 1)), 3) << " m "
-                  << Num(std::sqrt(P(3, 3)) * 180.0 / M_PI, 2) << " deg)";
+                  << Num(yaw_error_deg, 2) << " deg (sigma " << Num(std::sqrt(P(0, 0) + P(1, 1)), 3)
+                  << " m " << Num(std::sqrt(P(3, 3)) * 180.0 / M_PI, 2) << " deg)";
         }
         translation_m.push_back(e.norm());
-        yaw_deg.push_back(
-            std::abs(std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()), 2.0 * M_PI)) *
-            180.0 / M_PI);
-        const Eigen::Matrix2d A =
-            T_true.linear().topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity();
-        AtA += A.transpose() * A;
-        Atb += A.transpose() * e.head<2>();
-        rows.emplace_back(A, e.head<2>());
+        yaw_deg.push_back(std::abs(yaw_error_deg));
+        rows.emplace_back(
+            T_true.linear().template topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity(),
+            e.head<2>());
       });
   if (translation_m.empty()) return;
   report << "  submap matches vs truth: " << translation_m.size() << "; translation median "
@@ -203,6 +200,12 @@ void ReportLoopClosureErrors(const mapping::GraphLogContents& g,
          << Num(stats::Percentile(translation_m, 90.0), 3) << " m; yaw median "
          << Num(stats::Percentile(yaw_deg, 50.0), 2) << " deg, p90 "
          << Num(stats::Percentile(yaw_deg, 90.0), 2) << " deg";
+  Eigen::Matrix2d AtA = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d Atb = Eigen::Vector2d::Zero();
+  for (const auto& [A, e] : rows) {
+    AtA += A.transpose() * A;
+    Atb += A.transpose() * e;
+  }
   if (AtA.determinant() > 1e-6) {
     const Eigen::Vector2d d = AtA.ldlt().solve(Atb);
     double before = 0.0, after = 0.0;
@@ -231,19 +234,19 @@ void ReportFrameSwitchConsistency(const mapping::GraphLogContents& g,
   Eigen::Vector4d normalised_sq = Eigen::Vector4d::Zero();
   double nees_sum = 0.0, distance_sum_m = 0.0;
   int n = 0;
-  ForEachFactorWithTruth(
-      g, truth, mapping::FactorKind::kFrameSwitch, [&](const auto& f, const auto& T_true) {
-        Eigen::Vector4d e;
-        e.head<3>() = f.T_a_b.translation() - T_true.translation();
-        e(3) = std::remainder(YawOf(f.T_a_b.linear()) - YawOf(T_true.linear()), 2.0 * M_PI);
-        const Eigen::Matrix4d P = mapping::FourDofBlock(f.covariance);
-        sum += e;
-        sum_sq += e.cwiseAbs2();
-        normalised_sq += e.cwiseAbs2().cwiseQuotient(P.diagonal());
-        nees_sum += e.dot(P.ldlt().solve(e));
-        distance_sum_m += T_true.translation().norm();
-        ++n;
-      });
+  ForEachFactorWithTruth(g, truth, mapping::FactorKind::kFrameSwitch,
+                         [&](const auto& f, const auto& T_true) {
+                           Eigen::Vector4d e;
+                           e.head<3>() = f.T_a_b.translation() - T_true.translation();
+                           e(3) = YawErrorRad(f.T_a_b, T_true);
+                           const Eigen::Matrix4d P = mapping::FourDofBlock(f.covariance);
+                           sum += e;
+                           sum_sq += e.cwiseAbs2();
+                           normalised_sq += e.cwiseAbs2().cwiseQuotient(P.diagonal());
+                           nees_sum += e.dot(P.ldlt().solve(e));
+                           distance_sum_m += T_true.translation().norm();
+                           ++n;
+                         });
   if (n == 0) return;
   const Eigen::Vector4d mean = sum / n;
   const Eigen::Vector4d sd = (sum_sq / n - mean.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
