@@ -62,6 +62,9 @@ Subcommand AddVioCommand(CLI::App& app) {
                   "write one CSV row per VO frame (capture, status, quality, stage times)");
   cmd->add_option("--trajectory-out", options->trajectory_out_path,
                   "write the fused estimate (every filter output, frame 0) to this EuRoC CSV");
+  cmd->add_option("--vo-trajectory-out", options->vo_trajectory_out_path,
+                  "write the VO's chained poses alone (odometry frame: the body at the first\n"
+                  "keyframe) to this EuRoC CSV");
   cmd->footer(
       "The last line is\n"
       "  RESULT frames=... distance_m=... ate_rmse_m=... final_err_m=... final_err_pct=...\n"

@@ -418,6 +418,12 @@ VioRun RunVioExperiment(const VioCommandOptions& options, std::ostream& err) {
                         " filter outputs, frame 0) written to " + options.trajectory_out_path +
                         " (EuRoC CSV)");
   }
+  if (!options.vo_trajectory_out_path.empty()) {
+    ev::WriteEurocCsvTrajectory(run.vo_chain.trajectory(), options.vo_trajectory_out_path);
+    run.notes.push_back("VO chained poses (" + std::to_string(run.vo_chain.trajectory().size()) +
+                        ", odometry frame) written to " + options.vo_trajectory_out_path +
+                        " (EuRoC CSV)");
+  }
   Evaluate(truth, &run);
   run.wall_time_s = Seconds(std::chrono::steady_clock::now() - wall_start);
   return run;

@@ -49,6 +49,9 @@ struct VioCommandOptions {
       true;  ///< feed mav0/can0 wheel speeds if the dataset has them and their calibration
   int max_frames = 0;               ///< process at most this many stereo frames (0: all)
   std::string trajectory_out_path;  ///< write the fused estimate here (EuRoC CSV)
+  /// Write the VO's chained poses alone here (EuRoC CSV, odometry frame: the
+  /// body at the first keyframe), to see the VO's drift without the filter.
+  std::string vo_trajectory_out_path;
   /// Write one CSV row per VO frame here: stamp, status, quality, stage times.
   std::string vo_log_path;
   /// Progress on `err`: one line rewritten in place (a terminal) or a line
