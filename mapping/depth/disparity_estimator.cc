@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <stdexcept>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace rover::mapping {
@@ -13,8 +16,9 @@ int ModeOf(const std::string& mode) {
   if (mode == "sgbm") return cv::StereoSGBM::MODE_SGBM;
   if (mode == "sgbm_3way") return cv::StereoSGBM::MODE_SGBM_3WAY;
   if (mode == "hh") return cv::StereoSGBM::MODE_HH;
-  throw std::invalid_argument("DisparityOptions.mode: expected sgbm, sgbm_3way or hh, found '" +
-                              mode + "'");
+  if (mode == "hh4") return cv::StereoSGBM::MODE_HH4;
+  throw std::invalid_argument(
+      "DisparityOptions.mode: expected sgbm, sgbm_3way, hh4 or hh, found '" + mode + "'");
 }
 
 }  // namespace
@@ -32,6 +36,8 @@ DisparityOptions DisparityOptions::Load(const ConfigNode& node) {
   o.max_left_right_diff_px = node.Get<int>("max_left_right_diff_px", o.max_left_right_diff_px);
   o.mode = node.Get<std::string>("mode", o.mode);
   o.min_texture_dn = node.Get<double>("min_texture_dn", o.min_texture_dn);
+  o.flip_pass = node.Get<bool>("flip_pass", o.flip_pass);
+  o.max_flip_diff_px = node.Get<double>("max_flip_diff_px", o.max_flip_diff_px);
   o.Validate();
   return o;
 }
@@ -57,6 +63,10 @@ void DisparityOptions::Validate() const {
   if (!(min_texture_dn >= 0.0) || !std::isfinite(min_texture_dn)) {
     throw std::invalid_argument("DisparityOptions.min_texture_dn: expected >= 0, found " +
                                 std::to_string(min_texture_dn));
+  }
+  if (!(max_flip_diff_px >= 0.0) || !std::isfinite(max_flip_diff_px)) {
+    throw std::invalid_argument("DisparityOptions.max_flip_diff_px: expected >= 0, found " +
+                                std::to_string(max_flip_diff_px));
   }
   ModeOf(mode);
 }
@@ -105,6 +115,14 @@ void DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& right,
                                 std::to_string(left.cols) + "x" + std::to_string(left.rows));
   }
   sgbm_->compute(left, right, *disparity_q4);
+  if (options_.flip_pass) {
+    cv::Mat left_flipped, right_flipped, flipped_q4, second_q4;
+    cv::flip(left, left_flipped, 0);
+    cv::flip(right, right_flipped, 0);
+    sgbm_->compute(left_flipped, right_flipped, flipped_q4);
+    cv::flip(flipped_q4, second_q4, 0);
+    MergeFlipPass(second_q4, disparity_q4);
+  }
   // The matching window runs off the image within half a block of its
   // border: SGBM's values there (zero disparity, often) mean nothing, and
   // must not read as "infinitely far".
@@ -128,6 +146,27 @@ void DisparityEstimator::Compute(const cv::Mat& left, const cv::Mat& right,
                           texture < static_cast<float>(options_.min_texture_dn));
     } else {
       disparity_q4->setTo(cv::Scalar(InvalidValue()), texture < min_texture_);
+    }
+  }
+}
+
+void DisparityEstimator::MergeFlipPass(const cv::Mat& b, cv::Mat* a) const {
+  const int invalid = InvalidValue();
+  const int min_valid = options_.min_disparity_px * 16;
+  const auto max_diff_q4 = static_cast<int>(std::lround(options_.max_flip_diff_px * 16.0));
+  for (int v = 0; v < a->rows; ++v) {
+    int16_t* row_a = a->ptr<int16_t>(v);
+    const int16_t* row_b = b.ptr<int16_t>(v);
+    for (int u = 0; u < a->cols; ++u) {
+      const int da = row_a[u];
+      const int db = row_b[u];
+      if (da < min_valid || db < min_valid || std::abs(da - db) > max_diff_q4) {
+        row_a[u] = static_cast<int16_t>(invalid);
+        continue;
+      }
+      // Half of an odd sum rounds up on every other pixel: no bias from
+      // the fixed point.
+      row_a[u] = static_cast<int16_t>((da + db + ((u + v) & 1)) >> 1);
     }
   }
 }

@@ -32,8 +32,19 @@ struct DisparityOptions {
   int speckle_window_px = 100;  ///< 0 disables speckle filtering
   int speckle_range_px = 2;
   int max_left_right_diff_px = 1;  ///< left-right consistency; -1 disables it
-  /// "sgbm" (5 directions), "sgbm_3way" (faster) or "hh" (8 directions).
+  /// "sgbm" (5 directions), "sgbm_3way" (faster), "hh4" (4 directions, two
+  /// passes) or "hh" (8 directions, two passes).
   std::string mode = "sgbm_3way";
+  /// Also match the pair turned upside down and keep the mean of the two
+  /// disparities where they agree within `max_flip_diff_px` (else: none).
+  /// The one-pass modes aggregate their paths from the top of the image
+  /// down, and on a surface whose disparity grows down the image (the
+  /// ground) that pulls every disparity towards the rows above: -0.08 px on
+  /// the simulator's terrain, +0.3 % depth at 2 m and +0.7 % at 4 m. The
+  /// flipped pass is pulled the other way by as much. Twice the SGBM time;
+  /// the two-pass modes cost about three times and keep +0.03 px.
+  bool flip_pass = true;
+  double max_flip_diff_px = 1.0;
   /// Texture filter: pixels whose mean horizontal intensity gradient over a
   /// 7x7 window is below this (digital numbers per pixel, as the sensor
   /// counted them) get no disparity. SGBM's smoothness terms otherwise carry
@@ -73,6 +84,9 @@ class DisparityEstimator {
 
  private:
   DisparityOptions options_;
+  /// Mean of `a` and the second pass `b` where both matched and agree.
+  void MergeFlipPass(const cv::Mat& b, cv::Mat* a) const;
+
   cv::Ptr<cv::StereoSGBM> sgbm_;
   /// min_texture_dn times the left gain per pixel (CV_32FC1); empty when
   /// there is no gain and the scalar threshold applies everywhere.

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include "firmware/mapd/local_mapper.h"
@@ -17,6 +18,7 @@
 #include "hil/sim/render/stereo_renderer.h"
 #include "hil/sim/scenario/scenario.h"
 #include "hil/sim/world/world.h"
+#include "mapping/depth/depth_image.h"
 #include "mapping/submap/submap.h"
 
 namespace rover::sim::experiments {
@@ -47,6 +49,68 @@ std::string Spread(const std::vector<double>& values) {
          std::to_string(n);
 }
 
+// The q-quantile (0..1) of `v` by nearest rank; NaN if empty.
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<std::size_t>(k)];
+}
+
+// Signed depth errors of one depth image against the rendered z-depth of
+// the distorted cam0 image: each measured point is projected into cam0 and
+// its true point taken on the same ray (cam0 and cam0rect share the centre).
+class DepthBiasAccumulator {
+ public:
+  DepthBiasAccumulator(const calib::CameraModel& cam0, const Eigen::Isometry3d& T_body_cam0,
+                       const RectifiedHead& head)
+      : cam0_(cam0),
+        T_cam0_cam0rect_(T_body_cam0.inverse() * head.T_body_cam0rect),
+        fb_px_m_(head.stereo.focal_px * head.stereo.baseline_m) {}
+
+  void Add(const mapping::DepthImage& depth, const cv::Mat& depth0_m) {
+    constexpr int kStride = 4;
+    for (int v = 0; v < depth.height(); v += kStride) {
+      for (int u = 0; u < depth.width(); u += kStride) {
+        if (depth.state(u, v) != mapping::DepthState::kValid) continue;
+        const Eigen::Vector3d p_rect = depth.point(u, v).cast<double>();
+        const Eigen::Vector3d p_cam0 = T_cam0_cam0rect_ * p_rect;
+        const std::optional<Eigen::Vector2d> px = cam0_.Project(p_cam0);
+        if (!px || p_cam0.z() <= 0.0) continue;
+        const int col = static_cast<int>(std::lround(px->x()));
+        const int row = static_cast<int>(std::lround(px->y()));
+        if (col < 0 || row < 0 || col >= depth0_m.cols || row >= depth0_m.rows) continue;
+        const double z_true_cam0 = depth0_m.at<float>(row, col);
+        if (!(z_true_cam0 > 0.0)) continue;
+        const double z_true = p_rect.z() * z_true_cam0 / p_cam0.z();
+        disparity_error_px_.push_back(fb_px_m_ / p_rect.z() - fb_px_m_ / z_true);
+        const double relative = p_rect.z() / z_true - 1.0;
+        if (z_true >= 1.0 && z_true < 3.0) near_.push_back(relative);
+        if (z_true >= 3.0 && z_true < 5.0) mid_.push_back(relative);
+        if (z_true >= 5.0 && z_true < 10.0) far_.push_back(relative);
+      }
+    }
+  }
+
+  DepthBias Result() const {
+    DepthBias b;
+    b.samples = static_cast<long>(disparity_error_px_.size());
+    b.disparity_error_px_p50 = Quantile(disparity_error_px_, 0.5);
+    b.disparity_error_px_p10 = Quantile(disparity_error_px_, 0.1);
+    b.disparity_error_px_p90 = Quantile(disparity_error_px_, 0.9);
+    b.depth_error_1_3_m = Quantile(near_, 0.5);
+    b.depth_error_3_5_m = Quantile(mid_, 0.5);
+    b.depth_error_5_10_m = Quantile(far_, 0.5);
+    return b;
+  }
+
+ private:
+  calib::CameraModel cam0_;
+  Eigen::Isometry3d T_cam0_cam0rect_;
+  double fb_px_m_;
+  std::vector<double> disparity_error_px_, near_, mid_, far_;
+};
+
 }  // namespace
 
 void TerrainCommandOptions::Validate() const {
@@ -76,8 +140,13 @@ TerrainResult EvaluateTerrain(const TerrainCommandOptions& options, uint64_t see
 
   const Eigen::Isometry3d& T_body_cam0 = scenario.camera.T_body_cam0;
   StereoRenderer renderer(world, scenario.camera);
-  mapd::LocalMapper mapper({}, CameraModelOf(scenario.camera, T_body_cam0),
+  const calib::CameraModel cam0 = CameraModelOf(scenario.camera, T_body_cam0);
+  mapd::LocalMapperOptions mapper_options;
+  if (!options.disparity_mode.empty()) mapper_options.disparity.mode = options.disparity_mode;
+  mapd::LocalMapper mapper(mapper_options, cam0,
                            CameraModelOf(scenario.camera, scenario.camera.T_body_cam1()));
+  const RectifiedHead head = RectifiedHeadOf(scenario.camera);
+  DepthBiasAccumulator depth_bias(cam0, T_body_cam0, head);
   // The world as the submap frame: it is gravity-aligned like mapd's.
   mapping::Submap submap(0, 0, {});
   const double end_s = options.max_duration_s > 0.0
@@ -92,10 +161,13 @@ TerrainResult EvaluateTerrain(const TerrainCommandOptions& options, uint64_t see
     renderer.Render(T_world_body, {}, static_cast<uint64_t>(std::lround(t_s * camera_rate_hz)),
                     &frame);
     mapper.Process(frame.cam0, frame.cam1, T_world_body, &submap);
+    if (const mapping::DepthImage* depth = mapper.last_depth()) {
+      depth_bias.Add(*depth, frame.depth0_m);
+    }
     ++result.pairs;
   }
+  result.depth = depth_bias.Result();
   // The camera along the mapped stretch, every 0.25 s, as `rover-sim map`.
-  const RectifiedHead head = RectifiedHeadOf(scenario.camera);
   std::vector<Eigen::Isometry3d> cameras;
   for (double t_s = 0.0; t_s <= end_s; t_s += 0.25) {
     cameras.push_back(PoseOf(trajectory.Evaluate(t_s)) * head.T_body_cam0rect);
@@ -115,7 +187,11 @@ std::string TerrainResultFields(const TerrainResult& r) {
          " obstacle_points_true=" + std::to_string(q.obstacle_points_true) +
          " truth_cells_observed=" + std::to_string(q.truth_obstacle_cells_observed) +
          " truth_cells_found=" + std::to_string(q.truth_obstacle_cells_found) +
-         " map_precision=" + Num(q.map_precision, 4) + " map_recall=" + Num(q.map_recall, 4);
+         " map_precision=" + Num(q.map_precision, 4) + " map_recall=" + Num(q.map_recall, 4) +
+         " disparity_error_px_p50=" + Num(r.depth.disparity_error_px_p50, 3) +
+         " depth_error_pct_1_3m=" + Num(100.0 * r.depth.depth_error_1_3_m, 2) +
+         " depth_error_pct_3_5m=" + Num(100.0 * r.depth.depth_error_3_5_m, 2) +
+         " depth_error_pct_5_10m=" + Num(100.0 * r.depth.depth_error_5_10_m, 2);
 }
 
 int RunTerrain(const TerrainCommandOptions& options, std::ostream& out, std::ostream& err) {
@@ -153,6 +229,8 @@ cli::Subcommand AddTerrainCommand(CLI::App& app) {
   cmd->add_option("--max-duration-s", options->max_duration_s,
                   "map only the first S seconds of the route (0: all)")
       ->capture_default_str();
+  cmd->add_option("--disparity-mode", options->disparity_mode,
+                  "SGBM's path mode instead of mapd's: sgbm, sgbm_3way, hh4 or hh");
   AddObstacleScoringOptions(cmd, &options->quality);
   return {cmd, [options] { return RunTerrain(*options, std::cout, std::cerr); }};
 }

@@ -27,10 +27,28 @@ struct TerrainCommandOptions {
   double rate_hz = 2.0;
   /// Map only the first this many seconds of the route (0: all of it).
   double max_duration_s = 0.0;
+  /// SGBM's path mode (mapping::DisparityOptions::mode); empty: mapd's.
+  std::string disparity_mode;
   MapQualityOptions quality;
 
   /// Throws std::invalid_argument "TerrainCommandOptions.<key>: ...".
   void Validate() const;
+};
+
+/// SGBM's depth against the rendered depth along the same rays (kValid
+/// pixels, every fourth row and column). A bias here shifts every submap's
+/// content along its view, which no pose estimate can absorb.
+struct DepthBias {
+  long samples = 0;
+  /// Signed disparity error (measured - true) [px]: median, p10, p90.
+  double disparity_error_px_p50 = 0.0;
+  double disparity_error_px_p10 = 0.0;
+  double disparity_error_px_p90 = 0.0;
+  /// Median relative depth error (measured / true - 1) at true depths of
+  /// 1-3, 3-5 and 5-10 m; NaN where no sample fell.
+  double depth_error_1_3_m = 0.0;
+  double depth_error_3_5_m = 0.0;
+  double depth_error_5_10_m = 0.0;
 };
 
 /// One world's figures.
@@ -38,6 +56,7 @@ struct TerrainResult {
   uint64_t seed = 0;
   int pairs = 0;
   MapQuality quality;
+  DepthBias depth;
   double wall_s = 0.0;
 };
 

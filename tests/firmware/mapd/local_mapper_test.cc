@@ -103,7 +103,9 @@ TEST(LocalMapperTest, TheGroundKeepsItsDepthWhereTheFlatFieldBrightensIt) {
       if (depth.state(u, v) == mapping::DepthState::kValid) ++corner_valid;
     }
   }
-  EXPECT_GT(static_cast<double>(corner_valid) / corner, 0.8);
+  // 0.80 from one SGBM pass; the flipped second pass (DisparityOptions::
+  // flip_pass) drops the pixels where the two passes disagree: 0.79.
+  EXPECT_GT(static_cast<double>(corner_valid) / corner, 0.75);
 }
 
 }  // namespace
