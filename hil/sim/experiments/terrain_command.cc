@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "core/stats/percentile.h"
 #include "firmware/mapd/local_mapper.h"
 #include "hil/sim/experiments/map_command.h"
 #include "hil/sim/motion/rover_trajectory.h"
@@ -49,14 +50,6 @@ std::string Spread(const std::vector<double>& values) {
          std::to_string(n);
 }
 
-// The q-quantile (0..1) of `v` by nearest rank; NaN if empty.
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[static_cast<std::size_t>(k)];
-}
-
 // Signed depth errors of one depth image against the rendered z-depth of
 // the distorted cam0 image: each measured point is projected into cam0 and
 // its true point taken on the same ray (cam0 and cam0rect share the centre).
@@ -87,7 +80,6 @@ class DepthBiasAccumulator {
         const double relative = p_rect.z() / z_true - 1.0;
         if (z_true >= 1.0 && z_true < 3.0) near_.push_back(relative);
         if (z_true >= 3.0 && z_true < 5.0) mid_.push_back(relative);
-        if (z_true >= 5.0 && z_true < 10.0) far_.push_back(relative);
       }
     }
   }
@@ -95,12 +87,11 @@ class DepthBiasAccumulator {
   DepthBias Result() const {
     DepthBias b;
     b.samples = static_cast<long>(disparity_error_px_.size());
-    b.disparity_error_px_p50 = Quantile(disparity_error_px_, 0.5);
-    b.disparity_error_px_p10 = Quantile(disparity_error_px_, 0.1);
-    b.disparity_error_px_p90 = Quantile(disparity_error_px_, 0.9);
-    b.depth_error_1_3_m = Quantile(near_, 0.5);
-    b.depth_error_3_5_m = Quantile(mid_, 0.5);
-    b.depth_error_5_10_m = Quantile(far_, 0.5);
+    b.disparity_error_px_p50 = stats::Percentile(disparity_error_px_, 50.0);
+    b.disparity_error_px_p10 = stats::Percentile(disparity_error_px_, 10.0);
+    b.disparity_error_px_p90 = stats::Percentile(disparity_error_px_, 90.0);
+    b.depth_error_1_3_m = stats::Percentile(near_, 50.0);
+    b.depth_error_3_5_m = stats::Percentile(mid_, 50.0);
     return b;
   }
 
@@ -108,7 +99,7 @@ class DepthBiasAccumulator {
   calib::CameraModel cam0_;
   Eigen::Isometry3d T_cam0_cam0rect_;
   double fb_px_m_;
-  std::vector<double> disparity_error_px_, near_, mid_, far_;
+  std::vector<double> disparity_error_px_, near_, mid_;
 };
 
 }  // namespace
@@ -190,8 +181,7 @@ std::string TerrainResultFields(const TerrainResult& r) {
          " map_precision=" + Num(q.map_precision, 4) + " map_recall=" + Num(q.map_recall, 4) +
          " disparity_error_px_p50=" + Num(r.depth.disparity_error_px_p50, 3) +
          " depth_error_pct_1_3m=" + Num(100.0 * r.depth.depth_error_1_3_m, 2) +
-         " depth_error_pct_3_5m=" + Num(100.0 * r.depth.depth_error_3_5_m, 2) +
-         " depth_error_pct_5_10m=" + Num(100.0 * r.depth.depth_error_5_10_m, 2);
+         " depth_error_pct_3_5m=" + Num(100.0 * r.depth.depth_error_3_5_m, 2);
 }
 
 int RunTerrain(const TerrainCommandOptions& options, std::ostream& out, std::ostream& err) {

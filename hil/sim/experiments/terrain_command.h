@@ -45,10 +45,11 @@ struct DepthBias {
   double disparity_error_px_p10 = 0.0;
   double disparity_error_px_p90 = 0.0;
   /// Median relative depth error (measured / true - 1) at true depths of
-  /// 1-3, 3-5 and 5-10 m; NaN where no sample fell.
+  /// 1-3 and 3-5 m; NaN where no sample fell. (Further out few pixels stay
+  /// kValid, and the median on mixed-300m was -43 %: occlusion edges, where
+  /// the rendered depth at the projected pixel is the surface behind.)
   double depth_error_1_3_m = 0.0;
   double depth_error_3_5_m = 0.0;
-  double depth_error_5_10_m = 0.0;
 };
 
 /// One world's figures.
