@@ -86,10 +86,7 @@ class DepthBiasAccumulator {
 
   DepthBias Result() const {
     DepthBias b;
-    b.samples = static_cast<long>(disparity_error_px_.size());
     b.disparity_error_px_p50 = stats::Percentile(disparity_error_px_, 50.0);
-    b.disparity_error_px_p10 = stats::Percentile(disparity_error_px_, 10.0);
-    b.disparity_error_px_p90 = stats::Percentile(disparity_error_px_, 90.0);
     b.depth_error_1_3_m = stats::Percentile(near_, 50.0);
     b.depth_error_3_5_m = stats::Percentile(mid_, 50.0);
     return b;

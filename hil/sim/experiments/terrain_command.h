@@ -39,11 +39,8 @@ struct TerrainCommandOptions {
 /// pixels, every fourth row and column). A bias here shifts every submap's
 /// content along its view, which no pose estimate can absorb.
 struct DepthBias {
-  long samples = 0;
-  /// Signed disparity error (measured - true) [px]: median, p10, p90.
+  /// Median signed disparity error (measured - true) [px].
   double disparity_error_px_p50 = 0.0;
-  double disparity_error_px_p10 = 0.0;
-  double disparity_error_px_p90 = 0.0;
   /// Median relative depth error (measured / true - 1) at true depths of
   /// 1-3 and 3-5 m; NaN where no sample fell. (Further out few pixels stay
   /// kValid, and the median on mixed-300m was -43 %: occlusion edges, where

@@ -7,12 +7,12 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/stats/percentile.h"
 #include "mapping/depth/disparity_estimator.h"
 
 namespace rover::mapping {
@@ -177,8 +177,9 @@ TEST(DisparityEstimatorTest, RejectsABadLeftGainNamingIt) {
 }
 
 // A plane whose disparity grows by `slope_px_per_row` down the image, as the
-// ground does (from 12 px at the top; from 44 px if it shrinks): a smooth random texture resampled
-// (box-integrated, linear between texels) at each row's sub-pixel shift.
+// ground does (from 12 px at the top; from 44 px if it shrinks): a smooth
+// random texture resampled (box-integrated, linear between texels) at each
+// row's sub-pixel shift.
 struct SlantedPair {
   static constexpr int w = 320, h = 240;
   cv::Mat left, right;
@@ -233,9 +234,7 @@ double MedianDisparityError(const SlantedPair& pair, const DisparityEstimator& s
     }
   }
   EXPECT_GT(errors.size(), 0.8 * (SlantedPair::h - 20) * (SlantedPair::w - 90));
-  const auto middle = errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2);
-  std::nth_element(errors.begin(), middle, errors.end());
-  return *middle;
+  return stats::Percentile(errors, 50.0);
 }
 
 TEST(DisparityEstimatorTest, TheFlipPassRemovesTheSlantedSurfaceBias) {
