@@ -25,18 +25,12 @@
 #include <vector>
 
 #include "core/geometry/so3.h"
+#include "core/stats/percentile.h"
 #include "mapping/graph/rover_graph.h"
 #include "mapping/graph/synthetic_submap_trajectory.h"
 
 namespace rover::mapping {
 namespace {
-
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto k = static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
-  return v[std::min(k, v.size() - 1)];
-}
 
 double TimedOptimize(RoverGraph* graph, RoverGraphSummary* summary) {
   const auto start = std::chrono::steady_clock::now();
@@ -203,23 +197,25 @@ int Run(const Args& args) {
       const Eigen::SelfAdjointEigenSolver<Matrix6d> es(0.5 * (a - b + (a - b).transpose()));
       stale_min_eig = std::min(stale_min_eig, es.eigenvalues()(0) / b.norm());
     }
-    const double r50 = Percentile(t_full, 0.5) / Percentile(t_inc, 0.5);
-    const double r99 = Percentile(t_full, 0.99) / Percentile(t_inc, 0.99);
+    const double r50 = stats::Percentile(t_full, 50.0) / stats::Percentile(t_inc, 50.0);
+    const double r99 = stats::Percentile(t_full, 99.0) / stats::Percentile(t_inc, 99.0);
     ratio_p50.push_back(r50);
     ratio_p99.push_back(r99);
     gap_mm.push_back(1e3 * worst.translation_m);
     std::printf(
         "%4d %5zu | %6.2f %6.2f %6.2f (%5.2f) | %7.2f %7.2f %7.2f | %5.1f %5.1f | %6.3f %6.4f | "
         "%.1e / %.1e | %5.2f %5.2f | %4.1f %4.1f",
-        seed, t_inc.size(), Percentile(t_inc, 0.5), Percentile(t_inc, 0.99), Percentile(t_inc, 1.0),
-        Percentile(t_cov, 0.99), Percentile(t_full, 0.5), Percentile(t_full, 0.99),
-        Percentile(t_full, 1.0), r50, r99, 1e3 * worst.translation_m,
+        seed, t_inc.size(), stats::Percentile(t_inc, 50.0), stats::Percentile(t_inc, 99.0),
+        stats::Percentile(t_inc, 100.0), stats::Percentile(t_cov, 99.0),
+        stats::Percentile(t_full, 50.0), stats::Percentile(t_full, 99.0),
+        stats::Percentile(t_full, 100.0), r50, r99, 1e3 * worst.translation_m,
         worst.rotation_rad * 180.0 / 3.14159265358979, near_gap, stale_min_eig,
-        Percentile(t_ext, 0.99), Percentile(t_ext, 1.0),
-        Percentile(t_full_solve, 0.5) / Percentile(t_inc_solve, 0.5),
-        Percentile(t_full_solve, 0.99) / Percentile(t_inc_solve, 0.99));
+        stats::Percentile(t_ext, 99.0), stats::Percentile(t_ext, 100.0),
+        stats::Percentile(t_full_solve, 50.0) / stats::Percentile(t_inc_solve, 50.0),
+        stats::Percentile(t_full_solve, 99.0) / stats::Percentile(t_inc_solve, 99.0));
     if (args.ceres) {
-      std::printf(" | %7.1f %7.1f", Percentile(t_ceres, 0.5), Percentile(t_ceres, 0.99));
+      std::printf(" | %7.1f %7.1f", stats::Percentile(t_ceres, 50.0),
+                  stats::Percentile(t_ceres, 99.0));
     }
     std::printf("\n");
     std::fflush(stdout);

@@ -29,6 +29,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/stats/percentile.h"
 #include "mapping/depth/depth_image.h"
 #include "mapping/depth/disparity_estimator.h"
 #include "mapping/depth/stereo_error_model.h"
@@ -37,6 +38,7 @@
 namespace {
 
 namespace mapping = rover::mapping;
+namespace stats = rover::stats;
 using rover::mapd::testing::StereoScene;
 
 constexpr int kWidth = 752;
@@ -55,13 +57,6 @@ double NowMs() {
   return std::chrono::duration<double, std::milli>(
              std::chrono::steady_clock::now().time_since_epoch())
       .count();
-}
-
-// The q-quantile (0..1) by nearest rank.
-double Quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
-  return v[std::clamp<std::size_t>(rank, 1, v.size()) - 1];
 }
 
 StereoScene Scene() {
@@ -122,9 +117,9 @@ std::vector<double> TimeEach(int frames, int warmup, const std::function<void(in
 }
 
 void PrintTimes(const char* what, const std::vector<double>& ms) {
-  const double median = Quantile(ms, 0.5);
+  const double median = stats::Percentile(ms, 50.0);
   std::printf("  %-34s median %7.2f ms   p90 %7.2f ms   %6.1f fps\n", what, median,
-              Quantile(ms, 0.9), 1000.0 / median);
+              stats::Percentile(ms, 90.0), 1000.0 / median);
 }
 
 int Run(int frames, int warmup) {
@@ -232,11 +227,12 @@ int Run(int frames, int warmup) {
     std::printf(
         "  kValid |disparity error|: median %.3f px, p90 %.3f px, p99 %.3f px "
         "(3 sigma_z = %.2f px of disparity)\n",
-        Quantile(disparity_error_px, 0.5), Quantile(disparity_error_px, 0.9),
-        Quantile(disparity_error_px, 0.99), 3.0 * std::sqrt(2.0) * model.pixel_error_px());
+        stats::Percentile(disparity_error_px, 50.0), stats::Percentile(disparity_error_px, 90.0),
+        stats::Percentile(disparity_error_px, 99.0), 3.0 * std::sqrt(2.0) * model.pixel_error_px());
     std::printf("  kValid signed disparity error: median %+.3f px, p10 %+.3f px, p90 %+.3f px\n",
-                Quantile(signed_disparity_error_px, 0.5), Quantile(signed_disparity_error_px, 0.1),
-                Quantile(signed_disparity_error_px, 0.9));
+                stats::Percentile(signed_disparity_error_px, 50.0),
+                stats::Percentile(signed_disparity_error_px, 10.0),
+                stats::Percentile(signed_disparity_error_px, 90.0));
   }
   return 0;
 }
