@@ -61,9 +61,10 @@ struct Args {
   int first_seed = 1;
   int seeds = 3;
   int loop_every = 5;
-  double relinearize_rotation_rad = RoverGraphOptions{}.relinearize_rotation_rad;
-  double relinearize_translation_m = RoverGraphOptions{}.relinearize_translation_m;
-  int steps = RoverGraphOptions{}.incremental_steps;
+  // mapd's settings unless told otherwise.
+  double relinearize_rotation_rad = RoverGraphOptions::Online().relinearize_rotation_rad;
+  double relinearize_translation_m = RoverGraphOptions::Online().relinearize_translation_m;
+  int steps = RoverGraphOptions::Online().incremental_steps;
   bool ceres = false;
   bool verbose = false;
   double w_sigma_p_m = SyntheticSubmapTrajectoryOptions{}.w_sigma_p_m;

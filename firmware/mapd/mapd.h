@@ -72,17 +72,9 @@ struct MapdOptions {
   /// Run the pose graph (prior, frame switches; its own thread) and compose
   /// the global map at its optimised origins.
   bool slam = true;
-  /// iSAM2's way: one Gauss-Newton step per update, the rest of the
-  /// convergence in the graph thread's idle time, relinearising variables
-  /// that moved more than 2 mrad or 5 mm (about 1 mm from the exact optimum
-  /// at 1000 submaps, bench_graph_update).
-  mapping::RoverGraphOptions graph = [] {
-    mapping::RoverGraphOptions o;
-    o.incremental_steps = 1;
-    o.relinearize_rotation_rad = 0.002;
-    o.relinearize_translation_m = 0.005;
-    return o;
-  }();
+  /// The graph's online settings (RoverGraphOptions::Online: one
+  /// Gauss-Newton step per update, the rest in idle time).
+  mapping::RoverGraphOptions graph = mapping::RoverGraphOptions::Online();
   /// The frame switches' covariances in the graph: the filter's plus an
   /// odometry error per metre driven (mapping/slam/frame_switch_noise.h).
   mapping::FrameSwitchNoiseOptions switch_noise{};

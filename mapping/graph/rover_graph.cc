@@ -60,6 +60,14 @@ std::pair<Eigen::Isometry3d, Matrix6d> ComposeDetection(const RobotDetection& d)
   return {T, J * d.covariance_cam_marker * J.transpose()};
 }
 
+RoverGraphOptions RoverGraphOptions::Online() {
+  RoverGraphOptions o;
+  o.incremental_steps = 1;
+  o.relinearize_rotation_rad = 0.002;
+  o.relinearize_translation_m = 0.005;
+  return o;
+}
+
 RoverGraphOptions RoverGraphOptions::Load(const ConfigNode& node) {
   RoverGraphOptions o;
   o.cauchy_scale = node.GetInRange<double>("cauchy_scale", 1e-3, 1e3, o.cauchy_scale);

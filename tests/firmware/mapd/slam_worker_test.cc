@@ -38,11 +38,7 @@ std::vector<mapping::GraphFactorRecord> DriftingLoop() {
 }
 
 TEST(SlamWorkerTest, OneStepUpdatesAreRefinedInIdleTimeToTheConvergedSolution) {
-  mapping::RoverGraphOptions one_step;
-  one_step.incremental_steps = 1;
-  one_step.relinearize_rotation_rad = 0.002;
-  one_step.relinearize_translation_m = 0.005;
-  SlamWorker worker(one_step, 0);
+  SlamWorker worker(mapping::RoverGraphOptions::Online(), 0);
   mapping::RoverGraph reference;  // converges at every Optimize()
   const std::vector<mapping::GraphFactorRecord> factors = DriftingLoop();
   for (std::size_t i = 0; i + 1 < factors.size(); ++i) {

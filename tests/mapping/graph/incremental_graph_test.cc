@@ -197,9 +197,7 @@ TEST(IncrementalGraphTest, EveryUpdateAgreesWithTheFullSolveOverSeeds) {
 // Refine() is what finishes it.
 TEST(IncrementalGraphTest, OneStepUpdatesRefinedInIdleTimeAgreeWithTheFullSolve) {
   AgreementSetup setup;
-  setup.incremental_options.incremental_steps = 1;
-  setup.incremental_options.relinearize_rotation_rad = 0.002;
-  setup.incremental_options.relinearize_translation_m = 0.005;
+  setup.incremental_options = RoverGraphOptions::Online();
   setup.refine = true;
   setup.tolerance_m = 5e-3;
   setup.tolerance_rad = 0.02 * 3.14159265358979 / 180.0;
