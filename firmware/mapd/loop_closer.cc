@@ -55,6 +55,8 @@ LoopCloserOptions LoopCloserOptions::Load(const ConfigNode& node) {
     if (!child.Has("min_bound_m")) o.matcher.min_bound_m = mapd_defaults.min_bound_m;
     if (!child.Has("min_bound_yaw_rad"))
       o.matcher.min_bound_yaw_rad = mapd_defaults.min_bound_yaw_rad;
+    if (!child.Has("max_yaw_innovation_sigmas"))
+      o.matcher.max_yaw_innovation_sigmas = mapd_defaults.max_yaw_innovation_sigmas;
   }
   o.max_queued_pairs = node.Get<int>("max_queued_pairs", o.max_queued_pairs);
   o.nice_increment = node.Get<int>("nice_increment", o.nice_increment);

@@ -523,12 +523,12 @@ std::string YawInnovationRejection(const SubmapMatcherOptions& o, const MatchPri
                                    const SubmapMatchResult& r) {
   if (!prior.bounded || o.max_yaw_innovation_sigmas <= 0.0) return {};
   const double innovation_rad = std::abs(YawOf((prior.T_a_b.inverse() * r.T_a_b).linear()));
-  const double sigma_rad = std::sqrt(prior.covariance(5, 5) + r.covariance(5, 5));
+  const double sigma_rad = std::sqrt(prior.covariance(5, 5));
   const double limit_rad = o.max_yaw_innovation_sigmas * sigma_rad;
   if (innovation_rad <= limit_rad) return {};
   std::ostringstream text;
   text << "yaw " << innovation_rad << " rad off the prior's > " << limit_rad << " rad ("
-       << o.max_yaw_innovation_sigmas << " sigma of " << sigma_rad << ")";
+       << o.max_yaw_innovation_sigmas << " sigma of the prior's " << sigma_rad << ")";
   return text.str();
 }
 

@@ -238,6 +238,11 @@ TEST(LoopCloserOptionsTest, InvalidOptionsNameTheKey) {
   // Keys a child map does not name keep mapd's defaults.
   EXPECT_EQ(loaded.matcher.min_bound_m, LoopCloserOptions{}.matcher.min_bound_m);
   EXPECT_GT(loaded.matcher.min_bound_m, mapping::SubmapMatcherOptions{}.min_bound_m);
+  EXPECT_EQ(loaded.matcher.max_yaw_innovation_sigmas, 3.0);
+  // ... and a key it names is taken as given (0: the gate off).
+  const LoopCloserOptions ungated = LoopCloserOptions::Load(
+      ConfigNode::LoadString("matcher: {max_yaw_innovation_sigmas: 0}\n", "test"));
+  EXPECT_EQ(ungated.matcher.max_yaw_innovation_sigmas, 0.0);
 }
 
 }  // namespace

@@ -280,9 +280,9 @@ TEST_F(SubmapMatcherTest, AnIcpFromThePriorCannotLeaveItsBounds) {
 
 // The yaw innovation gate, turned on (k = 3): a prior confident in the
 // relative heading (sigma 0.1 deg) but 2 deg off the truth. The keypoints
-// find the truth, inside the prior's 3 deg bounds, yet 2 deg is beyond 3
-// sigma of the difference (prior and the match's floored 0.4 deg): refused.
-// A looser prior (1 deg), or the default (gate off), accepts the same match.
+// find the truth, inside the prior's 3 deg bounds, yet 2 deg is beyond 3 of
+// the prior's sigmas: refused. A looser prior (1 deg), or the default (gate
+// off), accepts the same match.
 TEST_F(SubmapMatcherTest, AMatchFarInYawFromAConfidentPriorIsRefusedWithTheGate) {
   const Isometry3d truth = Truth(0, 1);
   SubmapMatcherOptions gated;
