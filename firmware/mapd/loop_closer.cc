@@ -43,20 +43,10 @@ LoopCloserOptions LoopCloserOptions::Load(const ConfigNode& node) {
   if (node.Has("data")) o.data = mapping::SubmapMatchDataOptions::Load(node.Child("data"));
   // A child map sets the keys it names; the others keep mapd's defaults.
   if (node.Has("pairing")) {
-    const ConfigNode child = node.Child("pairing");
-    const double view_distance_m = o.pairing.view_distance_m;
-    o.pairing = mapping::SubmapPairingOptions::Load(child);
-    if (!child.Has("view_distance_m")) o.pairing.view_distance_m = view_distance_m;
+    o.pairing = mapping::SubmapPairingOptions::Load(node.Child("pairing"), o.pairing);
   }
   if (node.Has("matcher")) {
-    const ConfigNode child = node.Child("matcher");
-    const mapping::SubmapMatcherOptions mapd_defaults = o.matcher;
-    o.matcher = mapping::SubmapMatcherOptions::Load(child);
-    if (!child.Has("min_bound_m")) o.matcher.min_bound_m = mapd_defaults.min_bound_m;
-    if (!child.Has("min_bound_yaw_rad"))
-      o.matcher.min_bound_yaw_rad = mapd_defaults.min_bound_yaw_rad;
-    if (!child.Has("max_yaw_innovation_sigmas"))
-      o.matcher.max_yaw_innovation_sigmas = mapd_defaults.max_yaw_innovation_sigmas;
+    o.matcher = mapping::SubmapMatcherOptions::Load(node.Child("matcher"), o.matcher);
   }
   o.max_queued_pairs = node.Get<int>("max_queued_pairs", o.max_queued_pairs);
   o.nice_increment = node.Get<int>("nice_increment", o.nice_increment);

@@ -373,7 +373,12 @@ void SubmapMatcherOptions::Validate() const {
 }
 
 SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node) {
-  SubmapMatcherOptions o;
+  return Load(node, SubmapMatcherOptions{});
+}
+
+SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node,
+                                                const SubmapMatcherOptions& defaults) {
+  SubmapMatcherOptions o = defaults;
   o.mode = node.GetEnum<MatchMode>(
       "mode", {{"four_dof", MatchMode::kFourDof}, {"six_dof", MatchMode::kSixDof}}, o.mode);
   const auto d = [&node](const char* key, double* v) { *v = node.Get<double>(key, *v); };

@@ -170,7 +170,10 @@ struct SubmapMatcherOptions {
   /// Throws std::invalid_argument "SubmapMatcherOptions.<key>: ...".
   void Validate() const;
   /// Keys as the fields (mode: four_dof | six_dof; icp: a child map with
-  /// metric point_to_plane | point_to_point and the SubmapIcpOptions keys).
+  /// metric point_to_plane | point_to_point and the SubmapIcpOptions keys);
+  /// a key the node does not name keeps its value in `defaults`.
+  static SubmapMatcherOptions Load(const ConfigNode& node, const SubmapMatcherOptions& defaults);
+  /// As above, over the library's defaults.
   static SubmapMatcherOptions Load(const ConfigNode& node);
 };
 

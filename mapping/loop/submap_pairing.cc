@@ -70,7 +70,12 @@ void SubmapPairingOptions::Validate() const {
 }
 
 SubmapPairingOptions SubmapPairingOptions::Load(const ConfigNode& node) {
-  SubmapPairingOptions o;
+  return Load(node, SubmapPairingOptions{});
+}
+
+SubmapPairingOptions SubmapPairingOptions::Load(const ConfigNode& node,
+                                                const SubmapPairingOptions& defaults) {
+  SubmapPairingOptions o = defaults;
   o.min_overlap_m2 = node.Get<double>("min_overlap_m2", o.min_overlap_m2);
   o.overlap_sigma_factor = node.Get<double>("overlap_sigma_factor", o.overlap_sigma_factor);
   o.alpha = node.Get<double>("alpha", o.alpha);

@@ -69,7 +69,10 @@ struct SubmapPairingOptions {
 
   /// Throws std::invalid_argument "SubmapPairingOptions.<key>: ...".
   void Validate() const;
-  /// Keys as the fields.
+  /// Keys as the fields; a key the node does not name keeps its value in
+  /// `defaults`.
+  static SubmapPairingOptions Load(const ConfigNode& node, const SubmapPairingOptions& defaults);
+  /// As above, over the library's defaults.
   static SubmapPairingOptions Load(const ConfigNode& node);
 
   /// The right-hand side of eq. 6.3.
