@@ -52,6 +52,21 @@ Matrix6d InverseCovariance(const Eigen::Isometry3d& T_a_b, const Matrix6d& covar
 
 }  // namespace
 
+double ObstacleBoxOverlapM2(const Eigen::AlignedBox2d& box_a, const Eigen::Isometry3d& T_world_a,
+                            const Eigen::AlignedBox2d& box_b, const Eigen::Isometry3d& T_world_b,
+                            const Eigen::Vector2d& enlarge_m) {
+  const Eigen::AlignedBox2d world_a = WorldBox(box_a, T_world_a);
+  const Eigen::AlignedBox2d world_b = WorldBox(box_b, T_world_b);
+  if (world_a.isEmpty() || world_b.isEmpty()) return 0.0;
+  double area = 1.0;
+  for (int t = 0; t < 2; ++t) {
+    const double overlap =
+        std::min(world_a.max()(t), world_b.max()(t)) - std::max(world_a.min()(t), world_b.min()(t));
+    area *= std::max(0.0, overlap + enlarge_m(t));
+  }
+  return area;
+}
+
 bool SubmapPairing::WorseScore::operator()(const SubmapPair& x, const SubmapPair& y) const {
   if (x.score != y.score) return x.score < y.score;
   // Equal scores: the smaller ids first, for a deterministic order.
@@ -202,39 +217,52 @@ SubmapPair SubmapPairing::Evaluate(const SubmapId& a, const SubmapId& b) const {
   }
 
   // Eq. 6.1 / 6.2.
-  const Eigen::AlignedBox2d box_a = WorldBox(ea.box_xy, ea.T_world_origin);
-  const Eigen::AlignedBox2d box_b = WorldBox(eb.box_xy, eb.T_world_origin);
-  if (box_a.isEmpty() || box_b.isEmpty()) {
-    pair.overlap_m2 = 0.0;
-  } else {
-    double area = 1.0;
-    for (int t = 0; t < 2; ++t) {
-      const double overlap =
-          std::min(box_a.max()(t), box_b.max()(t)) - std::max(box_a.min()(t), box_b.min()(t));
-      area *= std::max(0.0, overlap + options_.overlap_sigma_factor * pair.relative_sigma_m(t));
-    }
-    pair.overlap_m2 = area;
-  }
+  pair.overlap_m2 =
+      ObstacleBoxOverlapM2(ea.box_xy, ea.T_world_origin, eb.box_xy, eb.T_world_origin,
+                           options_.overlap_sigma_factor * pair.relative_sigma_m.head<2>());
   // Eq. 6.4.
   pair.score = options_.alpha * pair.overlap_m2 + pair.relative_sigma_m.sum();
   return pair;
 }
 
-bool SubmapPairing::Candidate(const SubmapId& a, const SubmapId& b, SubmapPair* pair) const {
-  if (a == b) return false;
-  const Entry& ea = submaps_.at(a);
-  const Entry& eb = submaps_.at(b);
-  if (!ea.suitable || !eb.suitable) return false;
-  if (options_.skip_successive && a.robot == b.robot && std::abs(a.index - b.index) == 1) {
-    return false;
+const char* PairVerdictName(PairVerdict verdict) {
+  switch (verdict) {
+    case PairVerdict::kCandidate:
+      return "candidate";
+    case PairVerdict::kSameSubmap:
+      return "same submap";
+    case PairVerdict::kUnsuitable:
+      return "unsuitable submap";
+    case PairVerdict::kSuccessive:
+      return "successive submaps";
+    case PairVerdict::kDone:
+      return "matched before";
+    case PairVerdict::kSmallOverlap:
+      return "obstacle boxes overlap too little";
+    case PairVerdict::kBelowMatcherPrecision:
+      return "relative sigma below the matcher's precision";
   }
-  if (IsDone(a, b)) return false;
-  *pair = Evaluate(a, b);
-  if (!(pair->overlap_m2 > options_.min_overlap_m2)) return false;
+  return "unknown";
+}
+
+PairVerdict SubmapPairing::Check(const SubmapId& a, const SubmapId& b, SubmapPair* pair) const {
+  const Entry& ea = Find(a, "SubmapPairing::Check");
+  const Entry& eb = Find(b, "SubmapPairing::Check");
+  if (a == b) return PairVerdict::kSameSubmap;
+  if (!ea.suitable || !eb.suitable) return PairVerdict::kUnsuitable;
+  if (options_.skip_successive && a.robot == b.robot && std::abs(a.index - b.index) == 1) {
+    return PairVerdict::kSuccessive;
+  }
+  if (IsDone(a, b)) return PairVerdict::kDone;
+  const SubmapPair evaluated = Evaluate(a, b);
+  if (pair != nullptr) *pair = evaluated;
+  if (!(evaluated.overlap_m2 > options_.min_overlap_m2)) return PairVerdict::kSmallOverlap;
   // Eq. 6.3: a relative uncertainty below the matcher's precision leaves
   // nothing to gain.
-  if (pair->relative_sigma_m.mean() < options_.MatcherPrecisionM()) return false;
-  return true;
+  if (evaluated.relative_sigma_m.mean() < options_.MatcherPrecisionM()) {
+    return PairVerdict::kBelowMatcherPrecision;
+  }
+  return PairVerdict::kCandidate;
 }
 
 std::vector<SubmapPair> SubmapPairing::Candidates() const {
@@ -242,7 +270,7 @@ std::vector<SubmapPair> SubmapPairing::Candidates() const {
   for (auto ia = submaps_.begin(); ia != submaps_.end(); ++ia) {
     for (auto ib = std::next(ia); ib != submaps_.end(); ++ib) {
       SubmapPair pair;
-      if (Candidate(ia->first, ib->first, &pair)) out.push_back(pair);
+      if (Check(ia->first, ib->first, &pair) == PairVerdict::kCandidate) out.push_back(pair);
     }
   }
   std::sort(out.begin(), out.end(),

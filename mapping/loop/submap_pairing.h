@@ -79,6 +79,27 @@ struct SubmapPairingOptions {
   double MatcherPrecisionM() const;
 };
 
+/// Why a pair is, or is not, a candidate (the first rule it fails).
+enum class PairVerdict {
+  kCandidate,
+  kSameSubmap,
+  kUnsuitable,            ///< one of the two submaps is unsuitable for matching
+  kSuccessive,            ///< successive submaps of one robot
+  kDone,                  ///< handed out (matched) or marked done before
+  kSmallOverlap,          ///< eq. 6.2: overlap' not above min_overlap_m2
+  kBelowMatcherPrecision  ///< eq. 6.3: the graph already knows the pair better
+};
+
+/// Eq. 6.1 / 6.2: the product over x and y of the overlap of two submaps'
+/// obstacle boxes (submap frames) placed in the world, each axis's overlap
+/// enlarged by `enlarge_m` and floored at 0; 0 if either box is empty.
+double ObstacleBoxOverlapM2(const Eigen::AlignedBox2d& box_a, const Eigen::Isometry3d& T_world_a,
+                            const Eigen::AlignedBox2d& box_b, const Eigen::Isometry3d& T_world_b,
+                            const Eigen::Vector2d& enlarge_m = Eigen::Vector2d::Zero());
+
+/// "candidate", "unsuitable submap", ... for reports.
+const char* PairVerdictName(PairVerdict verdict);
+
 /// A pair to match, with the prior the matcher should use.
 struct SubmapPair {
   SubmapId a;
@@ -133,6 +154,11 @@ class SubmapPairing {
   /// (for diagnostics and tests). Throws for an unknown id.
   SubmapPair Evaluate(const SubmapId& a, const SubmapId& b) const;
 
+  /// Whether (a, b) is a candidate now and, if not, the first rule it
+  /// fails; fills `pair` (when given) as Evaluate does once the pair gets
+  /// as far as the overlap rule. Throws for an unknown id.
+  PairVerdict Check(const SubmapId& a, const SubmapId& b, SubmapPair* pair = nullptr) const;
+
   int submap_count() const { return static_cast<int>(submaps_.size()); }
   int suitable_count() const;
 
@@ -154,8 +180,6 @@ class SubmapPairing {
     bool operator()(const SubmapPair& x, const SubmapPair& y) const;
   };
   static Key Ordered(const SubmapId& a, const SubmapId& b);
-  /// Whether (a, b) passes every candidate rule; fills `pair`.
-  bool Candidate(const SubmapId& a, const SubmapId& b, SubmapPair* pair) const;
   const Entry& Find(const SubmapId& id, const char* caller) const;
 
   SubmapPairingOptions options_;

@@ -51,6 +51,18 @@ class Replay {
     while (std::optional<mapping::SubmapPair> pair = pairing_.Next()) Match(*pair);
   }
 
+  // One line per pair whose obstacle boxes overlap at the true origins.
+  void ExplainPairs() {
+    int explained = 0;
+    for (auto ia = data_.begin(); ia != data_.end(); ++ia) {
+      for (auto ib = std::next(ia); ib != data_.end(); ++ib) {
+        if (ExplainPair(ia->first, *ia->second, ib->first, *ib->second)) ++explained;
+      }
+    }
+    report_ << "    pairs: " << explained
+            << " pairs of non-successive submaps overlap at the true origins\n";
+  }
+
   mapping::RoverGraph& graph() { return graph_; }
   std::vector<mapping::GraphFactorRecord>& factors() { return factors_; }
   LoopReplayResult& result() { return result_; }
@@ -125,6 +137,8 @@ class Replay {
         std::sqrt(r.icp.covariance(5, 5)) * 180.0 / M_PI,
         T_true ? TruthError(pair, r, *T_true).c_str() : "");
     report_ << line;
+    outcome_[{std::min(pair.a.index, pair.b.index), std::max(pair.a.index, pair.b.index)}] =
+        r.accepted ? "matched: accepted" : "matched: rejected (" + r.rejection + ")";
     if (!r.accepted) return;
     ++result_.matches_accepted;
     if (T_true && IsValidLoopClosure(r.T_a_b, *T_true)) ++result_.matches_valid;
@@ -136,8 +150,37 @@ class Replay {
     UpdateOrigins();
   }
 
+  bool ExplainPair(int64_t a, const mapping::SubmapMatchData& data_a, int64_t b,
+                   const mapping::SubmapMatchData& data_b) {
+    const auto true_a = options_.true_origins.find(a);
+    const auto true_b = options_.true_origins.find(b);
+    if (true_a == options_.true_origins.end() || true_b == options_.true_origins.end()) {
+      return false;
+    }
+    const double true_overlap_m2 = mapping::ObstacleBoxOverlapM2(
+        data_a.obstacle_box_xy(), true_a->second, data_b.obstacle_box_xy(), true_b->second);
+    if (true_overlap_m2 <= 0.0) return false;
+    const mapping::PairVerdict verdict = pairing_.Check({robot_, a}, {robot_, b});
+    if (verdict == mapping::PairVerdict::kSuccessive) return false;  // not a revisit
+    const mapping::SubmapPair pair = pairing_.Evaluate({robot_, a}, {robot_, b});
+    const auto matched = outcome_.find({a, b});
+    char line[512];
+    std::snprintf(
+        line, sizeof(line),
+        "    pair %lld-%lld: true obstacle-box overlap %.1f m^2; %s; overlap' %.1f m^2 "
+        "(min %.1f), relative sigma %.3f m (matcher precision %.3f m)\n",
+        static_cast<long long>(a), static_cast<long long>(b), true_overlap_m2,
+        matched != outcome_.end() ? matched->second.c_str() : mapping::PairVerdictName(verdict),
+        pair.overlap_m2, options_.loop.pairing.min_overlap_m2, pair.relative_sigma_m.mean(),
+        options_.loop.pairing.MatcherPrecisionM());
+    report_ << line;
+    return true;
+  }
+
   const LoopReplayOptions& options_;
   std::ostream& report_;
+  /// "matched: accepted" / "matched: rejected (...)" by pair, for ExplainPairs.
+  std::map<std::pair<int64_t, int64_t>, std::string> outcome_;
   mapping::RoverGraph graph_;
   mapping::SubmapPairing pairing_;
   mapping::SubmapMatcher matcher_;
@@ -191,6 +234,7 @@ LoopReplayResult ReplayLoopClosing(const mapping::GraphLogContents& logged,
   }
   if (!has_prior) throw std::runtime_error("loop replay: the mapd log's graph has no prior");
   replay.graph().Optimize();
+  if (options.explain_pairs) replay.ExplainPairs();
   LoopReplayResult result = replay.result();
   result.graph.factors = replay.factors();
   FinalEstimates(logged, replay.graph(), &result.graph);

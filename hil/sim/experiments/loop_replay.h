@@ -32,6 +32,11 @@ struct LoopReplayOptions {
   mapping::FrameSwitchNoiseOptions switch_noise{};
   /// True origins by frame (simulation): each match's error is reported.
   std::map<int64_t, Eigen::Isometry3d> true_origins;
+  /// After the replay, one line per pair of submaps whose obstacle boxes
+  /// overlap at the true origins: what the pairing made of it at the end
+  /// (matched, or the rule that kept it out), to see which revisits loop
+  /// closing missed and why.
+  bool explain_pairs = false;
 };
 
 /// The definition of a valid loop closure the mission reports use: the

@@ -358,6 +358,7 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
             mapd::LoopCloserOptions::Load(ConfigNode::LoadFile(options.rematch_loop_config));
       }
       replay.true_origins = TrueOrigins(g, trajectory, mission, T_world_local0);
+      replay.explain_pairs = options.explain_pairs;
       const LoopReplayResult result =
           ReplayLoopClosing(g, mapping::ReadSubmapLog(path), replay, report);
       report << "  loop closing replayed offline: " << result.matches_accepted << " accepted of "
@@ -597,6 +598,12 @@ Subcommand AddMapCommand(CLI::App& app) {
                   "as mapd's loop section: data, pairing, matcher, max_queued_pairs, ...), to see "
                   "what another matcher setting would have found on the same submaps")
       ->check(CLI::ExistingFile);
+  cmd->add_flag("--explain-pairs", options->explain_pairs,
+                "with --rematch: one line per pair of submaps whose obstacle boxes overlap at the "
+                "true origins, saying whether it was matched or which pairing rule kept it out "
+                "(unsuitable submap, overlap too small, relative sigma below the matcher's "
+                "precision), to see which revisits loop closing missed and why")
+      ->needs("--rematch");
   cmd->add_flag("--true-origins", options->true_origins,
                 "diagnostic: compose the submaps at their true origins (the true body pose at "
                 "each frame switch), to separate the submaps' own quality from the origins' error");

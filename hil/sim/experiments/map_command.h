@@ -44,6 +44,9 @@ struct MapCommandOptions {
   /// keys: data, pairing, matcher, ...) to replay with instead of mapd's
   /// defaults; empty: the defaults.
   std::string rematch_loop_config;
+  /// With rematch: explain every pair of submaps whose obstacle boxes
+  /// overlap at the true origins (matched, or why not).
+  bool explain_pairs = false;
 };
 
 /// What RunMap measured (for rover-launch's RESULT line).

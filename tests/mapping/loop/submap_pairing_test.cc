@@ -62,6 +62,12 @@ TEST(SubmapPairing, OverlapEnlargedByTheRelativeSigmas) {
   strict.AddSubmap({0, 5}, true, Box(), At(3.5, 0), Cov(0.5));
   EXPECT_NEAR(strict.Evaluate({0, 0}, {0, 5}).overlap_m2, 2.0, 1e-9);
   EXPECT_TRUE(strict.Candidates().empty());
+  EXPECT_EQ(strict.Check({0, 0}, {0, 5}), PairVerdict::kSmallOverlap);
+  // The same overlap as a free function, at the true placement and enlarged.
+  EXPECT_NEAR(ObstacleBoxOverlapM2(Box(), At(0, 0), Box(), At(3.5, 0)), 2.0, 1e-9);
+  EXPECT_NEAR(ObstacleBoxOverlapM2(Box(), At(0, 0), Box(), At(3.5, 0), Vector2d(1.0, 0.5)),
+              1.5 * 4.5, 1e-9);
+  EXPECT_EQ(ObstacleBoxOverlapM2(Eigen::AlignedBox2d(), At(0, 0), Box(), At(0, 0)), 0.0);
 }
 
 TEST(SubmapPairing, BoxesFollowTheOriginEstimates) {
@@ -95,6 +101,12 @@ TEST(SubmapPairing, NeverSuccessiveNeverUnsuitable) {
   }
   EXPECT_EQ(pairing.suitable_count(), 3);
   EXPECT_EQ(pairing.submap_count(), 4);
+  // The verdicts name the rule each left-out pair fails first.
+  EXPECT_EQ(pairing.Check({0, 0}, {0, 1}), PairVerdict::kSuccessive);
+  EXPECT_EQ(pairing.Check({0, 0}, {0, 2}), PairVerdict::kUnsuitable);
+  EXPECT_EQ(pairing.Check({0, 1}, {0, 1}), PairVerdict::kSameSubmap);
+  EXPECT_EQ(pairing.Check({0, 0}, {1, 1}), PairVerdict::kCandidate);
+  EXPECT_STREQ(PairVerdictName(PairVerdict::kUnsuitable), "unsuitable submap");
 }
 
 TEST(SubmapPairing, DropsPairsMoreCertainThanTheMatcher) {
@@ -114,6 +126,9 @@ TEST(SubmapPairing, DropsPairsMoreCertainThanTheMatcher) {
     EXPECT_FALSE(p.a == (SubmapId{0, 0}) && p.b == (SubmapId{0, 3}));
   }
   EXPECT_EQ(c.size(), 2u);
+  SubmapPair p;
+  EXPECT_EQ(pairing.Check({0, 0}, {0, 3}, &p), PairVerdict::kBelowMatcherPrecision);
+  EXPECT_NEAR(p.relative_sigma_m.x(), std::sqrt(0.01 - 0.0025), 1e-12);
 }
 
 TEST(SubmapPairing, RanksByScoreAndHandsOutEachPairOnce) {
@@ -126,7 +141,10 @@ TEST(SubmapPairing, RanksByScoreAndHandsOutEachPairOnce) {
   while (auto p = pairing.Next()) order.push_back(*p);
   ASSERT_EQ(order.size(), 3u);
   for (std::size_t i = 1; i < order.size(); ++i) EXPECT_GE(order[i - 1].score, order[i].score);
-  for (const SubmapPair& p : order) EXPECT_TRUE(pairing.IsDone(p.a, p.b));
+  for (const SubmapPair& p : order) {
+    EXPECT_TRUE(pairing.IsDone(p.a, p.b));
+    EXPECT_EQ(pairing.Check(p.a, p.b), PairVerdict::kDone);
+  }
   // New estimates do not bring a done pair back.
   pairing.UpdateOrigin({0, 8}, At(1, 0), Cov(1.5));
   EXPECT_FALSE(pairing.Next().has_value());

@@ -138,6 +138,29 @@ TEST_F(LoopReplayTest, TheRevisitIsMatchedAndPullsItsOriginBackToTheTruth) {
   EXPECT_LT(e.rotation_rad, 1.0 * kDeg) << "the drift was 2 deg";
 }
 
+TEST_F(LoopReplayTest, ExplainedPairsSayWhetherTheyWereMatchedOrWhichRuleKeptThemOut) {
+  const mapping::GraphLogContents logged = LoggedGraph();
+  LoopReplayOptions options;
+  for (uint32_t frame : {1u, 2u, 3u, 4u}) options.true_origins[frame] = Truth(frame);
+  options.explain_pairs = true;
+  std::ostringstream report;
+  ReplayLoopClosing(logged, Submaps({1, 2, 3}), options, report);
+  // 1-3 is the only revisit (1-2 and 2-3 are far apart).
+  EXPECT_NE(report.str().find("pair 1-3: true obstacle-box overlap"), std::string::npos)
+      << report.str();
+  EXPECT_NE(report.str().find("matched: accepted"), std::string::npos) << report.str();
+  EXPECT_EQ(report.str().find("pair 1-2:"), std::string::npos) << report.str();
+  EXPECT_NE(report.str().find("pairs: 1 pairs"), std::string::npos) << report.str();
+
+  // An overlap threshold no pair reaches: the same pair, and the rule.
+  options.loop.pairing.min_overlap_m2 = 1e6;
+  std::ostringstream strict;
+  const LoopReplayResult r = ReplayLoopClosing(logged, Submaps({1, 2, 3}), options, strict);
+  EXPECT_EQ(r.pairs_matched, 0);
+  EXPECT_NE(strict.str().find("obstacle boxes overlap too little"), std::string::npos)
+      << strict.str();
+}
+
 TEST_F(LoopReplayTest, WithoutTheRevisitsSubmapNothingIsMatchedAndTheOriginsStay) {
   const mapping::GraphLogContents logged = LoggedGraph();
   std::ostringstream report;
