@@ -418,6 +418,7 @@ SubmapMatcherOptions SubmapMatcherOptions::Load(const ConfigNode& node,
     o.icp.convergence_m = icp.Get<double>("convergence_m", o.icp.convergence_m);
     o.icp.convergence_rad = icp.Get<double>("convergence_rad", o.icp.convergence_rad);
     o.icp.min_correspondences = icp.Get<int>("min_correspondences", o.icp.min_correspondences);
+    o.icp.robust_scale_m = icp.Get<double>("robust_scale_m", o.icp.robust_scale_m);
     o.icp.max_normal_angle_deg =
         icp.Get<double>("max_normal_angle_deg", o.icp.max_normal_angle_deg);
     o.icp.obstacle_agreement_distance_m =

@@ -339,6 +339,29 @@ void ReportOriginErrors(const mapping::GraphLogContents& g,
   report << "\n";
 }
 
+// Diagnostic for submaps placed at their true origins (map_evaluation.h).
+void ReportContentShift(const sim::Heightfield& terrain,
+                        const std::vector<mapping::SubmapLog>& logs,
+                        const std::map<uint32_t, Eigen::Isometry3d>& origins,
+                        std::ostream& report) {
+  std::vector<PlacedCloud> clouds;
+  for (const mapping::SubmapLog& log : logs) {
+    for (const mapping::LoggedSubmap& s : log.submaps) {
+      const auto origin = origins.find(s.info.frame_id);
+      if (s.cloud && origin != origins.end()) clouds.push_back({origin->second, s.cloud.get()});
+    }
+  }
+  const ContentShift shift = EstimateContentShift(terrain, clouds);
+  if (!shift.ok) {
+    report << "  submap content vs the true terrain: too few points on slopes to tell\n";
+    return;
+  }
+  report << "  submap content vs the true terrain (" << shift.points
+         << " cloud points): shifted forward " << Num(shift.forward_m, 3) << " m, left "
+         << Num(shift.left_m, 3) << " m, up " << Num(shift.up_m, 3)
+         << " m in each submap's frame\n";
+}
+
 // The submaps at the pose graph's optimised origins (mapping::
 // PlaceAtGraphOrigins), and the graph's final global pose against the truth.
 // A restarted mapd's log holds the whole graph again; later logs win.
@@ -469,6 +492,7 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   const auto start = std::chrono::steady_clock::now();
   const octomap::OcTree& map = composer.Compose();
   const mapping::PointCloud cloud = composer.ComposedCloud();
+  if (o.true_origins) ReportContentShift(world.terrain, logs, origins, report);
   r.compose_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   r.map_memory_bytes = composer.Stats().octree_memory_bytes + composer.Stats().cloud_memory_bytes;

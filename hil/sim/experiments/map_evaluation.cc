@@ -8,6 +8,8 @@
 #include <unordered_set>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "core/calib/stereo_rectifier.h"
 #include "mapping/depth/stereo_error_model.h"
 
@@ -335,6 +337,45 @@ MapQuality EvaluateMap(const sim::World& world, const sim::ObstacleGrid& truth,
   ScoreOccupancy(world, map_world, options, &q);
   ScoreObstacles(world, truth, rule, cloud_world, T_world_cameras, head, options, &q);
   return q;
+}
+
+ContentShift EstimateContentShift(const sim::Heightfield& terrain,
+                                  const std::vector<PlacedCloud>& clouds) {
+  constexpr double kMaxHeightErrorM = 0.1;  // rock overhangs, stereo outliers
+  constexpr double kMaxSlope = 1.0;         // steeper flanks are too nonlinear
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+  ContentShift out;
+  for (const PlacedCloud& placed : clouds) {
+    if (placed.cloud == nullptr) continue;
+    const Eigen::Isometry3d& T = placed.T_world_submap;
+    const Eigen::Vector2d forward = T.linear().col(0).head<2>().normalized();
+    const Eigen::Vector2d left(-forward.y(), forward.x());
+    for (const mapping::CloudPoint& c : *placed.cloud) {
+      const Eigen::Vector3d p = T * c.p_submap_m.cast<double>();
+      if (!terrain.Contains(p.x(), p.y())) continue;
+      const double error_m = p.z() - terrain.HeightAt(p.x(), p.y());
+      const Eigen::Vector2d g = terrain.GradientAt(p.x(), p.y());
+      if (std::abs(error_m) > kMaxHeightErrorM || g.norm() > kMaxSlope) continue;
+      // error = -g.forward d_forward - g.left d_left + d_up
+      const Eigen::Vector3d a(-g.dot(forward), -g.dot(left), 1.0);
+      AtA += a * a.transpose();
+      Atb += a * error_m;
+      ++out.points;
+    }
+  }
+  // Both slope directions must be seen, or forward and left are not
+  // separable (flat ground says nothing about a horizontal shift).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(AtA);
+  if (out.points < 100 || eig.eigenvalues()(0) < 1e-4 * static_cast<double>(out.points)) {
+    return out;
+  }
+  const Eigen::Vector3d d = AtA.ldlt().solve(Atb);
+  out.ok = true;
+  out.forward_m = d(0);
+  out.left_m = d(1);
+  out.up_m = d(2);
+  return out;
 }
 
 }  // namespace rover::sim::experiments

@@ -304,11 +304,14 @@ TEST(LoopOptions, ValidateNamesTheKey) {
 
 TEST(LoopOptions, LoadFromYaml) {
   const ConfigNode node = ConfigNode::LoadString(
-      "mode: six_dof\nmax_descriptor_distance: 0.3\nicp: {metric: point_to_point}\n", "test");
+      "mode: six_dof\nmax_descriptor_distance: 0.3\n"
+      "icp: {metric: point_to_point, robust_scale_m: 0.04}\n",
+      "test");
   const SubmapMatcherOptions m = SubmapMatcherOptions::Load(node);
   EXPECT_EQ(m.mode, MatchMode::kSixDof);
   EXPECT_EQ(m.max_descriptor_distance, 0.3);
   EXPECT_EQ(m.icp.metric, IcpMetric::kPointToPoint);
+  EXPECT_EQ(m.icp.robust_scale_m, 0.04);
   const SubmapMatchDataOptions d = SubmapMatchDataOptions::Load(
       ConfigNode::LoadString("descriptor: {kind: oriented, radius_m: 0.4}\n", "test"));
   EXPECT_EQ(d.descriptor.kind, GravityDescriptorKind::kOriented);
