@@ -239,11 +239,17 @@ TEST(LoopCloserOptionsTest, InvalidOptionsNameTheKey) {
   EXPECT_EQ(loaded.matcher.min_bound_m, LoopCloserOptions{}.matcher.min_bound_m);
   EXPECT_GT(loaded.matcher.min_bound_m, mapping::SubmapMatcherOptions{}.min_bound_m);
   EXPECT_EQ(loaded.matcher.max_yaw_innovation_sigmas, 3.0);
+  EXPECT_EQ(loaded.matcher.icp.robust_scale_m, 0.03);
+  EXPECT_EQ(loaded.matcher.icp.max_normal_angle_deg, 30.0);
   // ... and a key it names is taken as given (0: the gate off); the same
   // holds for the pairing's child map.
   const LoopCloserOptions ungated = LoopCloserOptions::Load(ConfigNode::LoadString(
       "matcher: {max_yaw_innovation_sigmas: 0}\npairing: {alpha: 0.25}\n", "test"));
   EXPECT_EQ(ungated.matcher.max_yaw_innovation_sigmas, 0.0);
+  const LoopCloserOptions plain_icp = LoopCloserOptions::Load(
+      ConfigNode::LoadString("matcher: {icp: {robust_scale_m: 0}}\n", "test"));
+  EXPECT_EQ(plain_icp.matcher.icp.robust_scale_m, 0.0);
+  EXPECT_EQ(plain_icp.matcher.icp.max_normal_angle_deg, 30.0);
   EXPECT_EQ(ungated.matcher.min_bound_m, LoopCloserOptions{}.matcher.min_bound_m);
   EXPECT_EQ(ungated.pairing.alpha, 0.25);
   EXPECT_EQ(ungated.pairing.view_distance_m, LoopCloserOptions{}.pairing.view_distance_m);
