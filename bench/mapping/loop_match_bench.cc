@@ -21,6 +21,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/flann.hpp>
 
+#include "firmware/mapd/loop_closer.h"
 #include "mapping/loop/submap_matcher.h"
 #include "tests/mapping/loop/loop_test_scene.h"
 
@@ -80,23 +81,19 @@ void MatchTimes(const Pair& pair, int reps) {
   prior.T_a_b = pair.truth * rover::GravityAlignedTransform({0.3, -0.2, 0.05}, 0.05);
   prior.covariance = mapping::Matrix6d::Identity() * 0.25;
   prior.covariance(5, 5) = 0.01;
-  // The thesis's 4D matcher, the same with mapd's ICP (Cauchy weights down
-  // to 3 cm, normals within 30 deg: firmware/mapd/loop_closer.h), and the 6D
-  // baseline.
+  // The thesis's 4D matcher (the library's defaults), the same with mapd's
+  // ICP (its robust weights and normal test), and the 6D baseline.
   struct Variant {
     const char* name;
     mapping::MatchMode mode;
-    bool robust_icp;
+    bool mapd_icp;
   };
   for (const Variant& v : {Variant{"4D", mapping::MatchMode::kFourDof, false},
-                           Variant{"4D, robust ICP", mapping::MatchMode::kFourDof, true},
+                           Variant{"4D, mapd's ICP", mapping::MatchMode::kFourDof, true},
                            Variant{"6D", mapping::MatchMode::kSixDof, false}}) {
     mapping::SubmapMatcherOptions o;
     o.mode = v.mode;
-    if (v.robust_icp) {
-      o.icp.robust_scale_m = 0.03;
-      o.icp.max_normal_angle_deg = 30.0;
-    }
+    if (v.mapd_icp) o.icp = rover::mapd::LoopCloserOptions{}.matcher.icp;
     const mapping::SubmapMatcher matcher(o);
     std::vector<double> total, corr, hough, ransac, icp;
     mapping::SubmapMatchResult r;
