@@ -1,5 +1,7 @@
 #include "firmware/mapd/loop_closer.h"
 
+#include <malloc.h>
+
 #include <chrono>
 #include <stdexcept>
 
@@ -163,7 +165,8 @@ void LoopCloser::PrepareWaiting(std::unique_lock<std::mutex>* lock) {
                 " has no matching data: " + e.what();
     }
     const int64_t frame = submap->frame_id();
-    submap.reset();  // the octree and cloud are no longer needed here
+    submap.reset();    // the octree and cloud are no longer needed here
+    ::malloc_trim(0);  // nor the build's transients: see RunMatching
     lock->lock();
     preparing_ = false;
     if (!data) {
@@ -269,6 +272,11 @@ void LoopCloser::RunMatching() {
       m.rejection = std::string("matcher failed: ") + e.what();
     }
     m.match_ms = MsSince(start);
+    job = QueuedPair{};
+    // The match's transients (correspondences, trees, ICP buffers) are
+    // freed: return their pages now rather than at the next finished
+    // submap, so that mapd's footprint between matches is what it holds.
+    ::malloc_trim(0);
     lock.lock();
     matching_ = false;
     ++stats_.pairs_matched;

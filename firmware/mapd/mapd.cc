@@ -496,6 +496,37 @@ void Mapd::FinishMappingSubmap() {
   // free pages of every malloc arena back to the system, so that mapd's
   // footprint follows what it holds, not its peaks, over a long mission.
   ::malloc_trim(0);
+  if (record != nullptr) LogMemory(record->last_stamp.nanoseconds());
+}
+
+void Mapd::LogMemory(int64_t stamp_ns) {
+  std::string error;
+  const std::optional<runtime::ProcessMemory> memory = runtime::ReadProcessMemory(&error);
+  if (!memory) {
+    if (!memory_error_reported_)
+      std::fprintf(stderr, "mapd: memory not logged: %s\n", error.c_str());
+    memory_error_reported_ = true;
+    return;
+  }
+  if (!first_memory_) first_memory_ = memory;
+  last_memory_ = memory;
+  log::diagnostic_msgs::DiagnosticStatus status;
+  status.level = log::diagnostic_msgs::DiagnosticStatus::kOk;
+  status.name = "mapd: memory";
+  status.hardware_id = options_.robot_name;
+  status.message = std::to_string(stats_.submaps_archived) + " submaps archived";
+  status.values = memory->ToKeyValues();
+  status.values.push_back({"submaps_archived", std::to_string(stats_.submaps_archived)});
+  if (loop_) {
+    const mapping::MatchDataStoreStats store = loop_->Stats().store;
+    status.values.push_back({"match_data_held", std::to_string(store.submaps)});
+    status.values.push_back({"match_data_resident", std::to_string(store.resident)});
+    status.values.push_back({"match_data_spilled_kb", std::to_string(store.spilled_bytes / 1024)});
+  }
+  log::diagnostic_msgs::DiagnosticArray array;
+  array.header.stamp = log::ToRosTime(Time::FromNanoseconds(stamp_ns));
+  array.status.push_back(std::move(status));
+  archive_->LogDiagnostics(array);
 }
 
 void Mapd::HandLatestPose() {
@@ -864,6 +895,21 @@ std::string Mapd::Summary() const {
                   static_cast<unsigned long long>(l.submaps), data_p50, match_p50, l.store.resident,
                   l.store.submaps, static_cast<double>(l.store.spilled_bytes) / 1e6,
                   static_cast<unsigned long long>(l.store.spill_reads));
+    out += text;
+  }
+  if (first_memory_ && last_memory_) {
+    const auto mb = [](uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); };
+    const auto kb_mb = [](uint64_t kb) { return static_cast<double>(kb) / 1024.0; };
+    char text[300];
+    std::snprintf(text, sizeof(text),
+                  "  memory: RSS %.1f -> %.1f MB from the first finished submap to the last "
+                  "(anonymous %.1f -> %.1f, shared %.1f -> %.1f); heap in use %.1f -> %.1f MB, "
+                  "free held %.1f -> %.1f MB\n",
+                  kb_mb(first_memory_->rss_kb), kb_mb(last_memory_->rss_kb),
+                  kb_mb(first_memory_->rss_anon_kb), kb_mb(last_memory_->rss_anon_kb),
+                  kb_mb(first_memory_->rss_shmem_kb), kb_mb(last_memory_->rss_shmem_kb),
+                  mb(first_memory_->heap_in_use_bytes), mb(last_memory_->heap_in_use_bytes),
+                  mb(first_memory_->heap_free_held_bytes), mb(last_memory_->heap_free_held_bytes));
     out += text;
   }
   char line[200];

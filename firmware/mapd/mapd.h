@@ -33,6 +33,7 @@
 #include "firmware/mapd/pose_history.h"
 #include "firmware/mapd/slam_worker.h"
 #include "firmware/mapd/submap_trigger.h"
+#include "firmware/runtime/health/process_memory.h"
 #include "firmware/runtime/topics/rover_topics.h"
 #include "mapping/slam/frame_switch_noise.h"
 #include "mapping/slam/graph_log.h"
@@ -222,6 +223,9 @@ class Mapd {
   void LogGlobalPose(const SlamSnapshot& snap);
   /// Adds the loop closer's accepted matches to the graph.
   void TakeLoopMatches();
+  /// Logs what mapd's memory is made of (a "mapd: memory" status on
+  /// /diagnostics), after a finished submap.
+  void LogMemory(int64_t stamp_ns);
 
   MapdOptions options_;
   SubmapTrigger trigger_;
@@ -263,6 +267,10 @@ class Mapd {
   std::optional<runtime::topics::SwitchReason> last_reason_;  ///< of the request out
   std::optional<uint32_t> request_frame_;  ///< the frame that request was made in
   MapdStats stats_;
+  /// Memory after the first and the latest finished submap.
+  std::optional<runtime::ProcessMemory> first_memory_;
+  std::optional<runtime::ProcessMemory> last_memory_;
+  bool memory_error_reported_ = false;
   uint64_t next_request_id_ = 1;
   Time last_status_wall_;
 };

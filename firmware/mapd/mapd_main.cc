@@ -44,6 +44,15 @@ int main(int argc, char** argv) {
   // fragmentation keeps their pages: mapd's footprint then creeps up over a
   // long mission. Fixed, blocks this large are mapped and returned whole.
   ::mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+  // One malloc arena for all of mapd's threads. glibc gives each thread that
+  // allocates its own arena (up to 8 per core); the mapping loop, the two
+  // loop-closure threads and the graph thread then each keep the high-water
+  // mark of their own transients, and the matcher's, which only appears
+  // once the rover revisits ground, adds to the footprint instead of reusing
+  // what the mapping loop has freed. None of these threads is real-time
+  // (roverd's loop is), and small blocks still come from per-thread caches
+  // without the arena lock.
+  ::mallopt(M_ARENA_MAX, 1);
   CLI::App app{
       "mapd: the rover's mapping process. Subscribes to roverd's estimates, stereo pairs and\n"
       "frame switches over iceoryx (RouDi must run: scripts/roudi.sh start, or the rover-roudi\n"

@@ -104,6 +104,12 @@ void SubmapArchive::LogOrigins(const log::rover_msgs::SubmapOrigins& origins) {
               origins);
 }
 
+void SubmapArchive::LogDiagnostics(const log::diagnostic_msgs::DiagnosticArray& diagnostics) {
+  if (!log_) return;
+  log_->Write("/diagnostics", log::FromRosTime(diagnostics.header.stamp).nanoseconds(),
+              diagnostics);
+}
+
 void SubmapArchive::LogGlobalPose(const log::geometry_msgs::PoseWithCovarianceStamped& pose) {
   if (!log_) return;
   log_->Write(mapping::kGlobalPoseTopic, log::FromRosTime(pose.header.stamp).nanoseconds(), pose);

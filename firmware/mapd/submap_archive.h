@@ -25,6 +25,7 @@
 
 #include <Eigen/Geometry>
 
+#include "core/log/msgs/diagnostic_msgs.h"
 #include "core/log/msgs/geometry_msgs.h"
 #include "core/log/msgs/nav_msgs.h"
 #include "core/log/msgs/rover_msgs.h"
@@ -66,6 +67,8 @@ class SubmapArchive {
   void LogFactor(const log::rover_msgs::GraphFactor& factor);
   /// Logs the graph's origins after an update that changed them.
   void LogOrigins(const log::rover_msgs::SubmapOrigins& origins);
+  /// Logs mapd's own diagnostics (its memory) on /diagnostics.
+  void LogDiagnostics(const log::diagnostic_msgs::DiagnosticArray& diagnostics);
   /// Logs the global pose after an update.
   void LogGlobalPose(const log::geometry_msgs::PoseWithCovarianceStamped& pose);
   /// Places the submaps at the pose graph's origins (T_world_frame by local

@@ -23,6 +23,7 @@
 #include "estimator/io/log_replay.h"
 #include "firmware/runtime/process/child_process.h"
 #include "mapping/slam/graph_log.h"
+#include "tests/firmware/mapd/log_topic.h"
 #include "tests/support/roudi_process.h"
 #include "tests/support/temp_dir.h"
 
@@ -44,24 +45,7 @@ pid_t WaitForPid(const fs::path& path, pid_t other, Duration timeout) {
   return 0;
 }
 
-template <typename Msg>
-std::vector<Msg> ReadTopic(const std::string& log_path, std::string_view topic) {
-  log::McapReader reader = log::McapReader::Open(log_path);
-  log::ReadOptions options;
-  for (const auto& [id, channel] : reader.channels()) {
-    if (channel.topic == topic) options.channel_ids.push_back(id);
-  }
-  std::vector<Msg> out;
-  reader.ForEachMessage(
-      [&](const log::MessageView& m) {
-        Msg msg;
-        EXPECT_TRUE(log::DeserializeMessage(m.data, &msg));
-        out.push_back(msg);
-        return true;
-      },
-      options);
-  return out;
-}
+using testing::ReadTopic;
 
 TEST(MapdCrashTest, KillingMapdLeavesNoGapInTheImuLoopAndMapdResumesWithANewSubmap) {
   std::string reason;

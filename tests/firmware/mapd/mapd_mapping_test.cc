@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -14,12 +15,14 @@
 #include <octomap/OcTree.h>
 
 #include "core/ipc/in_process_transport.h"
+#include "core/log/msgs/diagnostic_msgs.h"
 #include "core/log/msgs/message_traits.h"
 #include "core/log/msgs/nav_msgs.h"
 #include "firmware/mapd/mapd.h"
 #include "firmware/roverd/mapd_link.h"
 #include "mapping/compose/map_export.h"
 #include "mapping/compose/submap_log.h"
+#include "tests/firmware/mapd/log_topic.h"
 #include "tests/firmware/mapd/stereo_scene.h"
 
 namespace rover::mapd {
@@ -166,6 +169,22 @@ TEST_F(MapdMappingTest, MapsPairsIntoSubmapsLogsThemAndExportsTheGlobalMap) {
   EXPECT_GT(log.submaps[0].info.octree_bytes, 0u);
   EXPECT_GT(log.submaps[0].info.cloud_bytes, 0u);
   EXPECT_EQ(log.statistics.at("submaps"), "2");
+  // After each finished submap, what mapd's memory is made of.
+  const auto diagnostics = rover::testing::ReadTopic<log::diagnostic_msgs::DiagnosticArray>(
+      mapd->log_path(), "/diagnostics");
+  ASSERT_EQ(diagnostics.size(), 2u);
+  for (std::size_t k = 0; k < diagnostics.size(); ++k) {
+    ASSERT_EQ(diagnostics[k].status.size(), 1u);
+    const log::diagnostic_msgs::DiagnosticStatus& memory = diagnostics[k].status[0];
+    EXPECT_EQ(memory.name, "mapd: memory");
+    std::map<std::string, std::string> values;
+    for (const auto& kv : memory.values) values[kv.key] = kv.value;
+    EXPECT_EQ(values["submaps_archived"], std::to_string(k + 1));
+    EXPECT_GT(std::stoull(values.at("rss_anon_kb")), 1000u);
+    EXPECT_LE(std::stoull(values.at("rss_anon_kb")), std::stoull(values.at("rss_kb")));
+    EXPECT_TRUE(values.count("heap_in_use_kb") && values.count("heap_free_held_kb"));
+  }
+  EXPECT_NE(mapd->Summary().find("memory: RSS"), std::string::npos) << mapd->Summary();
   EXPECT_GE(log.traversability_grids, 1u);
   for (const mapping::LoggedSubmap& s : log.submaps) {
     // Ground voxels sit at the plane (10 cm voxels: centres within 0.1 m);
