@@ -1,21 +1,13 @@
 #include "mapping/tags/tag_detector.h"
 
 #include <apriltag/apriltag.h>
-#include <apriltag/tag16h5.h>
-#include <apriltag/tag25h9.h>
-#include <apriltag/tag36h10.h>
-#include <apriltag/tag36h11.h>
-#include <apriltag/tagCircle21h7.h>
-#include <apriltag/tagCircle49h12.h>
-#include <apriltag/tagCustom48h12.h>
-#include <apriltag/tagStandard41h12.h>
-#include <apriltag/tagStandard52h13.h>
 
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include "mapping/loop/option_checks.h"
+#include "mapping/tags/tag_family.h"
 
 namespace rover::mapping {
 namespace {
@@ -25,37 +17,6 @@ using loop_internal::CheckRange;
 
 // The library puts the centre of the top-left pixel at (0.5, 0.5), OpenCV at (0, 0).
 constexpr double kLibraryPixelCentreOffsetPx = 0.5;
-
-struct FamilyFactory {
-  const char* name;
-  apriltag_family_t* (*create)();
-  void (*destroy)(apriltag_family_t*);
-};
-
-constexpr FamilyFactory kFamilies[] = {
-    {"tag36h11", tag36h11_create, tag36h11_destroy},
-    {"tag36h10", tag36h10_create, tag36h10_destroy},
-    {"tag25h9", tag25h9_create, tag25h9_destroy},
-    {"tag16h5", tag16h5_create, tag16h5_destroy},
-    {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy},
-    {"tagCircle49h12", tagCircle49h12_create, tagCircle49h12_destroy},
-    {"tagCustom48h12", tagCustom48h12_create, tagCustom48h12_destroy},
-    {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
-    {"tagStandard52h13", tagStandard52h13_create, tagStandard52h13_destroy},
-};
-
-const FamilyFactory* FindFamily(const std::string& name) {
-  for (const FamilyFactory& f : kFamilies) {
-    if (name == f.name) return &f;
-  }
-  return nullptr;
-}
-
-std::string KnownList() {
-  std::string out;
-  for (const FamilyFactory& f : kFamilies) out += (out.empty() ? "" : ", ") + std::string(f.name);
-  return out;
-}
 
 // Twice the signed area of the quad (shoelace); positive for one winding.
 double SignedArea2(const std::array<Eigen::Vector2d, 4>& c) {
@@ -83,22 +44,17 @@ bool Convex(const std::array<Eigen::Vector2d, 4>& c) {
 
 }  // namespace
 
-std::vector<std::string> KnownTagFamilies() {
-  std::vector<std::string> out;
-  for (const FamilyFactory& f : kFamilies) out.emplace_back(f.name);
-  return out;
-}
-
 void TagDetectorOptions::Validate() const {
   constexpr const char* kName = "TagDetectorOptions";
   if (families.empty()) {
     throw std::invalid_argument(std::string(kName) + ".families: expected at least one of " +
-                                KnownList() + ", found none");
+                                KnownTagFamilyList() + ", found none");
   }
   for (const std::string& f : families) {
-    if (FindFamily(f) == nullptr) {
-      throw std::invalid_argument(std::string(kName) + ".families: expected one of " + KnownList() +
-                                  ", found '" + f + "'");
+    try {
+      CreateTagFamily(f);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(kName) + ".families: " + e.what());
     }
   }
   CheckRange(kName, "max_bits_corrected", max_bits_corrected, 0, 3);
@@ -123,15 +79,12 @@ class TagDetector::Impl {
     detector_->decode_sharpening = o.decode_sharpening;
     detector_->nthreads = o.threads;
     for (const std::string& name : o.families) {
-      const FamilyFactory* f = FindFamily(name);
-      apriltag_family_t* family = f->create();
-      families_.push_back({family, f->destroy});
-      apriltag_detector_add_family_bits(detector_, family, o.max_bits_corrected);
+      families_.push_back(CreateTagFamily(name));
+      apriltag_detector_add_family_bits(detector_, families_.back().get(), o.max_bits_corrected);
     }
   }
   ~Impl() {
-    apriltag_detector_destroy(detector_);
-    for (auto& [family, destroy] : families_) destroy(family);
+    apriltag_detector_destroy(detector_);  // before the families it refers to
   }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -140,7 +93,7 @@ class TagDetector::Impl {
 
  private:
   apriltag_detector_t* detector_;
-  std::vector<std::pair<apriltag_family_t*, void (*)(apriltag_family_t*)>> families_;
+  std::vector<TagFamilyPtr> families_;
 };
 
 TagDetector::TagDetector(const TagDetectorOptions& options) : options_(options) {

@@ -98,9 +98,6 @@ class TagDetector {
   std::unique_ptr<Impl> impl_;
 };
 
-/// The family names TagDetectorOptions::families accepts.
-std::vector<std::string> KnownTagFamilies();
-
 }  // namespace rover::mapping
 
 #endif  // ROVER_MAPPING_TAGS_TAG_DETECTOR_H_

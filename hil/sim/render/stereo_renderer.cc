@@ -15,10 +15,10 @@
 #include <string>
 #include <utility>
 
-#include "hil/sim/render/apriltag_pattern.h"
 #include "hil/sim/render/egl_context.h"
 #include "hil/sim/render/sensor_effects.h"
 #include "hil/sim/render/terrain_lod.h"
+#include "mapping/tags/tag_pattern.h"
 
 namespace rover::sim {
 namespace {
@@ -657,7 +657,7 @@ void StereoRenderer::Impl::UploadObjects(const World& world) {
   std::vector<uint8_t> layers;
   int border_cells = 8;
   for (auto& [id, layer] : layer_of_id) {
-    const TagPattern pattern = Tag36h11Pattern(id);
+    const mapping::TagPattern pattern = mapping::MakeTagPattern("tag36h11", id);
     tag_cells = pattern.cells_per_side;
     border_cells = pattern.border_cells;
     layer = static_cast<int>(layers.size() / pattern.cells.size());

@@ -1,8 +1,6 @@
 // Unit checks of the renderer's parts that need no GL: the lens model, the
 // tag pattern, the terrain level-of-detail selection and the sensor model.
 
-#include <apriltag/apriltag.h>
-#include <apriltag/tag36h11.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -16,7 +14,6 @@
 #include <vector>
 
 #include "core/config/config.h"
-#include "hil/sim/render/apriltag_pattern.h"
 #include "hil/sim/render/sensor_effects.h"
 #include "hil/sim/render/stereo_camera.h"
 #include "hil/sim/render/terrain_lod.h"
@@ -100,29 +97,6 @@ TEST(StereoCameraTest, ProjectionMatchesOpenCv) {
     EXPECT_NEAR(uv.x(), projected[i].x, 1e-9);
     EXPECT_NEAR(uv.y(), projected[i].y, 1e-9);
   }
-}
-
-TEST(TagPatternTest, MatchesTheLibrarysTagImage) {
-  apriltag_family_t* family = tag36h11_create();
-  for (const int id : {0, 1, 5, 42, 586}) {
-    const TagPattern pattern = Tag36h11Pattern(id);
-    image_u8_t* reference = apriltag_to_image(family, id);
-    ASSERT_EQ(pattern.cells_per_side, reference->width);
-    ASSERT_EQ(pattern.cells_per_side, reference->height);
-    EXPECT_EQ(pattern.border_cells, 8);
-    for (int y = 0; y < reference->height; ++y) {
-      for (int x = 0; x < reference->width; ++x) {
-        EXPECT_EQ(pattern.cells[static_cast<std::size_t>(y * pattern.cells_per_side + x)],
-                  reference->buf[y * reference->stride + x])
-            << "id " << id << " cell (" << x << ", " << y << ")";
-      }
-    }
-    // image_u8_destroy is not exported by Debian's build: free as it would.
-    std::free(reference->buf);
-    std::free(reference);
-  }
-  tag36h11_destroy(family);
-  EXPECT_THROW(Tag36h11Pattern(587), std::out_of_range);
 }
 
 // A tilted plane (which every level represents exactly) with one sharp
