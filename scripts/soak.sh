@@ -121,6 +121,9 @@ awk -F, -v warm="$WARMUP_S" -v max="$MAX_GROWTH_PCT" -v window="$WINDOW_S" '
     exit (rg > max || mg > max) ? 1 : 0
   }' "$OUT/rss.csv" | tee "$OUT/summary.txt"
 growth=${PIPESTATUS[0]}
+# mapd's own account (its /diagnostics log): whether what grew is heap in use,
+# free pages the allocator holds, or the shared IPC pool.
+grep -a '^  memory: RSS' "$RUN_LOG" | sed 's/^  /soak: mapd /' | tee -a "$OUT/summary.txt" || true
 drops_ok=1
 [[ "$RESULT" =~ imu_drops=0\  && "$RESULT" =~ frame_drops=0\  ]] || drops_ok=0
 if [[ $growth -ne 0 || $drops_ok -ne 1 ]]; then
