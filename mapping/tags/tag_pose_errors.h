@@ -1,0 +1,45 @@
+#ifndef ROVER_MAPPING_TAGS_TAG_POSE_ERRORS_H_
+#define ROVER_MAPPING_TAGS_TAG_POSE_ERRORS_H_
+
+// How far a tag pose may be off, per degree of freedom, in the frame the
+// graph's detection factors use: translation in the camera frame [m] and
+// rotation as a right perturbation of the tag's attitude [rad]
+// (T_true = T_est * Exp(dtheta)). Both steps of the thesis's model (6.2.3)
+// produce these: the offline table of maximum errors over distance and tilt,
+// and the online spread of the pose under corner perturbations.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+
+#include "core/calib/stereo_rectifier.h"
+
+namespace rover::mapping {
+
+/// [dx dy dz (camera) ; droll dpitch dyaw (tag, right)].
+using TagPoseErrors = Eigen::Matrix<double, 6, 1>;
+
+/// The error of `estimate` against `truth` in that parametrisation.
+TagPoseErrors TagPoseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
+
+struct CornerPerturbation {
+  /// Largest deviation per degree of freedom from the mean of all solved
+  /// poses (the unperturbed one and the 256 perturbed).
+  TagPoseErrors max_deviation = TagPoseErrors::Zero();
+  int solved = 0;  ///< of 257
+  /// Perturbed samples whose best pose fell on the other branch of the
+  /// planar ambiguity (more than `flip_angle_rad` from the unperturbed one).
+  int flipped = 0;
+};
+
+/// The thesis's online step: every combination of +-delta_px on the eight
+/// corner coordinates (2^8 = 256 samples) through the same PnP as the
+/// detection. Flipped samples are counted, and their poses kept in the
+/// spread: a pose that flips under calibration-sized noise is unstable.
+CornerPerturbation PerturbCorners(const std::array<Eigen::Vector2d, 4>& corners_px,
+                                  double tag_size_m, const calib::RectifiedIntrinsics& camera,
+                                  double delta_px, double flip_angle_rad = 0.35);
+
+}  // namespace rover::mapping
+
+#endif  // ROVER_MAPPING_TAGS_TAG_POSE_ERRORS_H_
