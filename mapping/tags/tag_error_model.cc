@@ -1,0 +1,112 @@
+#include "mapping/tags/tag_error_model.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/geometry/so3.h"
+#include "mapping/loop/option_checks.h"
+
+namespace rover::mapping {
+namespace {
+
+using loop_internal::CheckPositive;
+using loop_internal::CheckRange;
+
+using Vector8d = Eigen::Matrix<double, 8, 1>;
+
+Vector8d Corners(const Eigen::Isometry3d& T, double s, const calib::RectifiedIntrinsics& camera) {
+  const std::array<Eigen::Vector2d, 4> c = ProjectTagCorners(T, s, camera);
+  Vector8d v;
+  for (int k = 0; k < 4; ++k) v.segment<2>(2 * k) = c[static_cast<std::size_t>(k)];
+  return v;
+}
+
+// T (+) delta in the parametrisation of TagPoseErrors.
+Eigen::Isometry3d Perturbed(const Eigen::Isometry3d& T, const TagPoseErrors& delta) {
+  Eigen::Isometry3d out = T;
+  out.translation() += delta.head<3>();
+  out.linear() = T.linear() * ExpSO3(delta.tail<3>());
+  return out;
+}
+
+Matrix6d Diagonal(const TagPoseErrors& sigma) {
+  return sigma.array().square().matrix().asDiagonal();
+}
+
+}  // namespace
+
+void TagErrorModelOptions::Validate() const {
+  constexpr const char* kName = "TagErrorModelOptions";
+  CheckRange(kName, "corner_delta_px", corner_delta_px, 0.0, 10.0);
+  CheckPositive(kName, "sigma_per_max_error", sigma_per_max_error);
+  CheckPositive(kName, "corner_sigma_px", corner_sigma_px);
+  CheckRange(kName, "max_flipped_fraction", max_flipped_fraction, 0.0, 1.0);
+  CheckRange(kName, "max_ambiguity_ratio", max_ambiguity_ratio, 0.0, 1.0);
+}
+
+Matrix6d AnalyticTagCovariance(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
+                               const calib::RectifiedIntrinsics& camera, double corner_sigma_px) {
+  // Central differences: the projection is smooth and this runs once per
+  // detection.
+  Eigen::Matrix<double, 8, 6> J;
+  for (int k = 0; k < 6; ++k) {
+    const double h = k < 3 ? 1e-6 * std::max(1.0, T_camera_tag.translation().norm()) : 1e-6;
+    TagPoseErrors d = TagPoseErrors::Zero();
+    d[k] = h;
+    J.col(k) = (Corners(Perturbed(T_camera_tag, d), tag_size_m, camera) -
+                Corners(Perturbed(T_camera_tag, -d), tag_size_m, camera)) /
+               (2.0 * h);
+  }
+  const Matrix6d information = J.transpose() * J / (corner_sigma_px * corner_sigma_px);
+  // Nearly singular when the tag is tiny or seen edge-on: the pseudo-inverse
+  // then leaves a direction unconstrained, so refuse that case upstream by
+  // the huge variance it implies instead.
+  return information.completeOrthogonalDecomposition().pseudoInverse();
+}
+
+TagErrorModel::TagErrorModel(const TagErrorModelOptions& options,
+                             std::optional<TagErrorTable> table)
+    : options_(options), table_(std::move(table)) {
+  options_.Validate();
+  if (options_.kind == TagErrorModelKind::kTable && !table_) {
+    throw std::invalid_argument("TagErrorModel: the table model needs a tag error table");
+  }
+}
+
+TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& corners_px,
+                                       const TagPose& pose, double tag_size_m,
+                                       const calib::RectifiedIntrinsics& camera) const {
+  TagUncertainty u;
+  u.perturbation = PerturbCorners(corners_px, tag_size_m, camera, options_.corner_delta_px);
+  std::ostringstream why;
+  const double flipped = u.perturbation.flipped / 256.0;
+  if (u.perturbation.solved == 0) {
+    why << "no pose for the detected corners";
+  } else if (flipped > options_.max_flipped_fraction) {
+    why << "ambiguous: " << u.perturbation.flipped << " of 256 perturbed poses flip to the other "
+        << "solution";
+  } else if (pose.ambiguity_ratio > options_.max_ambiguity_ratio) {
+    why << "ambiguous: the two solutions fit within a ratio of " << pose.ambiguity_ratio
+        << " (at most " << options_.max_ambiguity_ratio << ")";
+  }
+  u.refusal = why.str();
+  if (!u.refusal.empty()) return u;
+  if (options_.kind == TagErrorModelKind::kTable) {
+    const TagPoseErrors base = table_->Lookup(pose.distance_m, pose.tilt_rad);
+    u.sigma = options_.sigma_per_max_error * base.cwiseMax(u.perturbation.max_deviation);
+    u.covariance = Diagonal(u.sigma);
+  } else {
+    u.covariance =
+        AnalyticTagCovariance(pose.best.T_camera_tag, tag_size_m, camera, options_.corner_sigma_px);
+    u.sigma = u.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  }
+  if (!u.covariance.allFinite() || !(u.sigma.array() > 0.0).all()) {
+    u.refusal = "degenerate covariance";
+    return u;
+  }
+  u.accepted = true;
+  return u;
+}
+
+}  // namespace rover::mapping

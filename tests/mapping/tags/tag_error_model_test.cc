@@ -1,0 +1,159 @@
+#include "mapping/tags/tag_error_model.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <stdexcept>
+
+#include "mapping/tags/tag_detector.h"
+#include "mapping/tags/tag_image_renderer.h"
+#include "mapping/tags/tag_pattern.h"
+#include "tests/mapping/tags/synthetic_tag_image.h"
+
+namespace rover::mapping {
+namespace {
+
+using testing::TagAt;
+using testing::TestCamera;
+
+constexpr double kTagSizeM = 0.16;
+constexpr double kChi2Six95 = 12.592;
+
+TagErrorTableSpec CoarseSpec() {
+  TagErrorTableSpec spec;
+  spec.camera = TestCamera();
+  spec.tag_size_m = kTagSizeM;
+  spec.distance_steps = 14;
+  spec.tilt_steps = 15;
+  return spec;
+}
+
+const TagErrorTable& Table() {
+  static const TagErrorTable table = TagErrorTable::Build(CoarseSpec());
+  return table;
+}
+
+TEST(TagPerturbationTest, ANearObliqueTagIsStableAndAFarHeadOnOneFlips) {
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const auto near = ProjectTagCorners(TagAt(1.0, 0.6, 0.1), kTagSizeM, camera);
+  const CornerPerturbation stable = PerturbCorners(near, kTagSizeM, camera, 0.3);
+  EXPECT_EQ(stable.solved, 257);
+  EXPECT_EQ(stable.flipped, 0);
+  EXPECT_GT(stable.max_deviation[2], 1e-4) << "the corners moved, so does the pose";
+  EXPECT_LT(stable.max_deviation[2], 0.01);
+  const auto far = ProjectTagCorners(TagAt(6.0, 0.05), kTagSizeM, camera);
+  const CornerPerturbation unstable = PerturbCorners(far, kTagSizeM, camera, 0.3);
+  EXPECT_GT(unstable.flipped, 10);
+  EXPECT_GT(unstable.max_deviation.tail<3>().maxCoeff(), 0.2);
+}
+
+TEST(TagErrorModelTest, AnalyticCovarianceMatchesTheSpreadOfNoisyPoses) {
+  // The Jacobian-propagated covariance against Monte Carlo: PnP on corners
+  // with Gaussian noise of the same sigma.
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const Eigen::Isometry3d T = TagAt(1.5, 0.7, -0.2);
+  const auto corners = ProjectTagCorners(T, kTagSizeM, camera);
+  constexpr double kSigmaPx = 0.2;
+  const Matrix6d analytic = AnalyticTagCovariance(T, kTagSizeM, camera, kSigmaPx);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, kSigmaPx);
+  Matrix6d sum = Matrix6d::Zero();
+  constexpr int kSamples = 3000;
+  for (int n = 0; n < kSamples; ++n) {
+    auto c = corners;
+    for (auto& p : c) p += Eigen::Vector2d(noise(rng), noise(rng));
+    std::string error;
+    const auto pose = EstimateTagPose(c, kTagSizeM, camera, &error);
+    ASSERT_TRUE(pose.has_value()) << error;
+    const TagPoseErrors e = TagPoseError(T, pose->best.T_camera_tag);
+    sum += e * e.transpose();
+  }
+  const Matrix6d empirical = sum / kSamples;
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_NEAR(std::sqrt(analytic(k, k)), std::sqrt(empirical(k, k)),
+                0.15 * std::sqrt(empirical(k, k)))
+        << "dof " << k;
+  }
+}
+
+TEST(TagErrorModelTest, TheTableModelTakesTheLargerOfTableAndSpread) {
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const TagErrorModel model(TagErrorModelOptions{}, Table());
+  const auto corners = ProjectTagCorners(TagAt(1.2, 0.5, 0.1), kTagSizeM, camera);
+  std::string error;
+  const auto pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
+  ASSERT_TRUE(pose.has_value()) << error;
+  const TagUncertainty u = model.Evaluate(corners, *pose, kTagSizeM, camera);
+  ASSERT_TRUE(u.accepted) << u.refusal;
+  const TagPoseErrors expected =
+      0.35 *
+      Table().Lookup(pose->distance_m, pose->tilt_rad).cwiseMax(u.perturbation.max_deviation);
+  EXPECT_TRUE(u.sigma.isApprox(expected));
+  EXPECT_TRUE(u.covariance.isApprox(Matrix6d(expected.array().square().matrix().asDiagonal())));
+}
+
+TEST(TagErrorModelTest, AnUnstablePoseIsRefusedAsAmbiguous) {
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const TagErrorModel model(TagErrorModelOptions{}, Table());
+  const auto corners = ProjectTagCorners(TagAt(6.0, 0.05), kTagSizeM, camera);
+  std::string error;
+  const auto pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
+  ASSERT_TRUE(pose.has_value()) << error;
+  const TagUncertainty u = model.Evaluate(corners, *pose, kTagSizeM, camera);
+  EXPECT_FALSE(u.accepted);
+  EXPECT_NE(u.refusal.find("ambiguous"), std::string::npos) << u.refusal;
+}
+
+TEST(TagErrorModelTest, CoversTheTrueErrorOfRenderedDetections) {
+  // Tags rendered with other blur, noise and contrast than the table's,
+  // anywhere in the view: the accepted detections' NEES stays within the
+  // chi^2(6) 95 % bound for at least 90 % of them, and no pose on the wrong
+  // side of the ambiguity is accepted.
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const TagErrorModel model(TagErrorModelOptions{}, Table());
+  TagDetector detector(TagDetectorOptions{});
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int accepted = 0, in_bound = 0, wrong_accepted = 0;
+  for (int n = 0; n < 80; ++n) {
+    const double d = 0.4 + 4.0 * unit(rng);
+    const double tilt = (unit(rng) - 0.5) * 140.0 * M_PI / 180.0;
+    const Eigen::Isometry3d T = TagAt(d, tilt, (unit(rng) - 0.5) * 0.5 * d);
+    TagRenderOptions render;
+    render.blur_sigma_px = 0.4 + 0.6 * unit(rng);
+    render.noise_sigma_dn = 2.0 * unit(rng);
+    render.noise_seed = static_cast<uint64_t>(n) + 1;
+    const cv::Mat image = RenderTagImage(MakeTagPattern("tag36h11", n), kTagSizeM, T, camera,
+                                         cv::Size(752, 480), render);
+    const auto found = detector.Detect(image);
+    if (found.size() != 1) continue;
+    std::string error;
+    const auto pose = EstimateTagPose(found[0].corners_px, kTagSizeM, camera, &error);
+    if (!pose) continue;
+    const TagUncertainty u = model.Evaluate(found[0].corners_px, *pose, kTagSizeM, camera);
+    if (!u.accepted) continue;
+    ++accepted;
+    const TagPoseErrors e = TagPoseError(pose->best.T_camera_tag, T);
+    wrong_accepted += e.tail<3>().norm() > 20.0 * M_PI / 180.0;
+    in_bound += e.dot(u.covariance.ldlt().solve(e)) <= kChi2Six95;
+  }
+  EXPECT_GT(accepted, 40);
+  EXPECT_GE(in_bound, 0.9 * accepted) << in_bound << " of " << accepted;
+  EXPECT_EQ(wrong_accepted, 0);
+}
+
+TEST(TagErrorModelTest, OptionsAreChecked) {
+  EXPECT_THROW(TagErrorModel(TagErrorModelOptions{}, std::nullopt), std::invalid_argument);
+  TagErrorModelOptions o;
+  o.sigma_per_max_error = 0.0;
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+  o = TagErrorModelOptions{};
+  o.max_flipped_fraction = 1.5;
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+  o = TagErrorModelOptions{};
+  o.kind = TagErrorModelKind::kAnalytic;
+  EXPECT_NO_THROW(TagErrorModel(o, std::nullopt));
+}
+
+}  // namespace
+}  // namespace rover::mapping
