@@ -13,7 +13,7 @@
 //
 //   bench_tag_model [--samples N] [--seed S] [--table-steps N] [--delta-px X]
 //                   [--corner-sigma-px X] [--sigma-per-max X] [--max-flipped F]
-//                   [--max-ambiguity R]
+//                   [--max-ambiguity R] [--decimate D]
 
 #include <chrono>
 #include <cmath>
@@ -50,11 +50,13 @@ struct Args {
   int samples = 600;
   uint32_t seed = 1;
   int table_steps = 50;
-  double delta_px = 0.3;
-  double corner_sigma_px = 0.3;
-  double sigma_per_max = 1.0;
-  double max_flipped = 0.0;
-  double max_ambiguity = 0.8;
+  // The library's defaults unless given.
+  double delta_px = TagErrorModelOptions{}.corner_delta_px;
+  double corner_sigma_px = TagErrorModelOptions{}.corner_sigma_px;
+  double sigma_per_max = TagErrorModelOptions{}.sigma_per_max_error;
+  double max_flipped = TagErrorModelOptions{}.max_flipped_fraction;
+  double max_ambiguity = TagErrorModelOptions{}.max_ambiguity_ratio;
+  double decimate = TagDetectorOptions{}.quad_decimate;
 };
 
 Args Parse(int argc, char** argv) {
@@ -84,6 +86,8 @@ Args Parse(int argc, char** argv) {
       a.max_flipped = std::atof(next());
     else if (s == "--max-ambiguity")
       a.max_ambiguity = std::atof(next());
+    else if (s == "--decimate")
+      a.decimate = std::atof(next());
     else {
       std::fprintf(stderr, "unknown argument %s (see the comment at the top of the source)\n",
                    s.c_str());
@@ -136,7 +140,9 @@ int Run(int argc, char** argv) {
   analytic_options.corner_sigma_px = args.corner_sigma_px;
   const TagErrorModel analytic_model(analytic_options, std::nullopt);
 
-  TagDetector detector(TagDetectorOptions{});
+  TagDetectorOptions detector_options;
+  detector_options.quad_decimate = args.decimate;
+  TagDetector detector(detector_options);
   std::mt19937 rng(args.seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   ModelStats stats[2];

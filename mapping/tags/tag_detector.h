@@ -38,9 +38,12 @@ struct TagDetectorOptions {
   /// Weaker decodes than this (the library's decision margin, grey levels)
   /// are refused.
   double min_decision_margin = 30.0;
-  /// 1: quads found at full resolution (the most accurate corners); 2 halves
-  /// the detection time at some loss of range and corner accuracy.
-  double quad_decimate = 1.0;
+  /// Quads are found on the image decimated by this, their edges then
+  /// refined at full resolution (refine_edges). 2 takes a quarter of the
+  /// time of 1 (bench_tag_model: 8 against 32 ms per 752x480 image) at the
+  /// same corner accuracy, and loses only distant tags, which the error
+  /// model mostly refuses as ambiguous anyway.
+  double quad_decimate = 2.0;
   /// Gaussian blur [px] before quad detection; 0: none.
   double quad_sigma_px = 0.0;
   bool refine_edges = true;
