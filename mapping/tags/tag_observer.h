@@ -1,0 +1,106 @@
+#ifndef ROVER_MAPPING_TAGS_TAG_OBSERVER_H_
+#define ROVER_MAPPING_TAGS_TAG_OBSERVER_H_
+
+// One camera's tag detections as the graph needs them: detect on a rectified
+// image, keep the configured markers (the size of each id, and whether it
+// sits on a fixed landmark or on another robot), solve both poses, judge
+// the uncertainty with the error model, and say for every decoded tag
+// whether it is accepted and, if not, why. Counts by outcome for mapd's
+// status. Not thread-safe: one observer per thread.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/calib/stereo_rectifier.h"
+#include "core/config/config.h"
+#include "mapping/tags/tag_detector.h"
+#include "mapping/tags/tag_error_model.h"
+#include "mapping/tags/tag_error_table.h"
+#include "mapping/tags/tag_pose.h"
+
+namespace rover::mapping {
+
+/// One configured marker: a tag id of the family, its printed size and what
+/// carries it.
+struct TagMarker {
+  int id = 0;
+  double size_m = 0.0;
+  /// A fixed landmark (an `o` factor to landmark `landmark`) or a robot (a
+  /// `d` factor to robot `robot`).
+  enum class Carrier { kLandmark, kRobot };
+  Carrier carrier = Carrier::kLandmark;
+  int64_t landmark = 0;
+  int robot = 0;
+  /// Where the tag sits on its carrier (tag frame: x right, y down, z into
+  /// the tag).
+  Eigen::Isometry3d T_carrier_tag = Eigen::Isometry3d::Identity();
+};
+
+struct TagObserverOptions {
+  TagDetectorOptions detector{};
+  TagErrorModelOptions model{};
+  std::vector<TagMarker> markers;
+
+  /// Throws std::invalid_argument naming the key: the detector's and the
+  /// model's checks, marker ids unique and within the family, sizes > 0,
+  /// one family (the detector's first).
+  void Validate() const;
+  /// Keys: families, max_hamming, min_decision_margin, quad_decimate,
+  /// corner_delta_px, sigma_per_max_error, max_flipped_fraction,
+  /// max_ambiguity_ratio, model (table | analytic), markers: [{id, size_m,
+  /// landmark: N | robot: N, T_carrier_tag: 4x4 row-major (optional)}].
+  static TagObserverOptions Load(const ConfigNode& node);
+};
+
+struct TagObservation {
+  TagDetection detection;
+  const TagMarker* marker = nullptr;  ///< null: an id not in the configuration
+  std::optional<TagPose> pose;
+  TagUncertainty uncertainty;
+  bool accepted = false;
+  std::string refusal;  ///< why not, when not accepted
+};
+
+struct TagObserverStats {
+  uint64_t images = 0;
+  uint64_t decoded = 0;  ///< tags the library decoded
+  uint64_t accepted = 0;
+  uint64_t not_configured = 0;
+  uint64_t refused_by_detector = 0;  ///< misread, weak, cut by the border, degenerate
+  uint64_t refused_by_model = 0;     ///< ambiguous (flips, equal fits) or degenerate
+  uint64_t no_pose = 0;
+};
+
+class TagObserver {
+ public:
+  /// The table model needs, for every configured marker size, a table made
+  /// for `camera`, `image_size`, the family and that size (rover-tags lut).
+  /// Throws std::invalid_argument saying what does not fit or is missing.
+  TagObserver(const TagObserverOptions& options, const calib::RectifiedIntrinsics& camera,
+              cv::Size image_size, const std::vector<TagErrorTable>& tables);
+
+  /// Every decoded tag in one rectified image, accepted or with its refusal.
+  /// Throws std::invalid_argument for an image of another size or type.
+  std::vector<TagObservation> Observe(const cv::Mat& rectified);
+
+  const TagObserverStats& stats() const { return stats_; }
+
+ private:
+  TagObserverOptions options_;
+  calib::RectifiedIntrinsics camera_;
+  cv::Size image_size_;
+  TagDetector detector_;
+  /// One model per marker size [0.1 mm], each with its table.
+  std::map<int64_t, TagErrorModel> models_;
+  TagObserverStats stats_;
+};
+
+}  // namespace rover::mapping
+
+#endif  // ROVER_MAPPING_TAGS_TAG_OBSERVER_H_

@@ -1,0 +1,127 @@
+#include "mapping/tags/tag_observer.h"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "core/config/config.h"
+#include "mapping/tags/tag_image_renderer.h"
+#include "mapping/tags/tag_pattern.h"
+#include "tests/mapping/tags/synthetic_tag_image.h"
+
+namespace rover::mapping {
+namespace {
+
+using testing::RenderTag;
+using testing::TagAt;
+using testing::TestCamera;
+
+const cv::Size kImage(752, 480);
+
+TagErrorTable SmallTable(double size_m) {
+  TagErrorTableSpec spec;
+  spec.camera = TestCamera();
+  spec.tag_size_m = size_m;
+  spec.distance_steps = 8;
+  spec.tilt_steps = 9;
+  return TagErrorTable::Build(spec);
+}
+
+const std::vector<TagErrorTable>& Tables() {
+  static const std::vector<TagErrorTable> tables{SmallTable(0.16), SmallTable(0.24)};
+  return tables;
+}
+
+TagObserverOptions TwoMarkers() {
+  TagObserverOptions o;
+  TagMarker post;
+  post.id = 3;
+  post.size_m = 0.16;
+  post.landmark = 12;
+  TagMarker rover;
+  rover.id = 7;
+  rover.size_m = 0.24;
+  rover.carrier = TagMarker::Carrier::kRobot;
+  rover.robot = 1;
+  o.markers = {post, rover};
+  return o;
+}
+
+TEST(TagObserverTest, AcceptsAConfiguredTagWithItsPoseAndCovariance) {
+  TagObserver observer(TwoMarkers(), TestCamera(), kImage, Tables());
+  for (const auto& [id, size_m] : {std::pair{3, 0.16}, std::pair{7, 0.24}}) {
+    const Eigen::Isometry3d T = TagAt(1.8, 0.5, -0.2);
+    const auto seen = observer.Observe(RenderTag(id, size_m, T, TestCamera()));
+    ASSERT_EQ(seen.size(), 1u);
+    const TagObservation& o = seen[0];
+    ASSERT_TRUE(o.accepted) << o.refusal;
+    ASSERT_NE(o.marker, nullptr);
+    EXPECT_EQ(o.marker->id, id);
+    EXPECT_LT((o.pose->best.T_camera_tag.translation() - T.translation()).norm(), 0.02);
+    EXPECT_GT(o.uncertainty.covariance.ldlt().vectorD().minCoeff(), 0.0);
+  }
+  EXPECT_EQ(observer.stats().accepted, 2u);
+  EXPECT_EQ(observer.stats().images, 2u);
+  EXPECT_EQ(TwoMarkers().markers[1].carrier, TagMarker::Carrier::kRobot);
+}
+
+TEST(TagObserverTest, AnIdNotConfiguredIsRefusedAndCounted) {
+  TagObserver observer(TwoMarkers(), TestCamera(), kImage, Tables());
+  const auto seen = observer.Observe(RenderTag(9, 0.16, TagAt(1.5, 0.4), TestCamera()));
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_FALSE(seen[0].accepted);
+  EXPECT_EQ(seen[0].refusal, "tag id 9 is not in the configuration");
+  EXPECT_EQ(observer.stats().not_configured, 1u);
+  EXPECT_EQ(observer.stats().accepted, 0u);
+}
+
+TEST(TagObserverTest, TablesMustFitTheCameraAndEveryMarkerSize) {
+  calib::RectifiedIntrinsics other = TestCamera();
+  other.fx += 20.0;
+  try {
+    TagObserver observer(TwoMarkers(), other, kImage, Tables());
+    FAIL() << "tables for another camera were accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("another camera"), std::string::npos) << e.what();
+  }
+  try {
+    TagObserver observer(TwoMarkers(), TestCamera(), kImage, {Tables()[0]});
+    FAIL() << "a marker size without a table was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no tag error table for tag36h11 240 mm"),
+              std::string::npos)
+        << e.what();
+  }
+  TagObserverOptions analytic = TwoMarkers();
+  analytic.model.kind = TagErrorModelKind::kAnalytic;
+  EXPECT_NO_THROW(TagObserver(analytic, TestCamera(), kImage, {}));
+  TagObserver observer(TwoMarkers(), TestCamera(), kImage, Tables());
+  EXPECT_THROW(observer.Observe(cv::Mat(240, 376, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
+}
+
+TEST(TagObserverTest, LoadsItsConfigurationAndNamesWhatIsWrong) {
+  const TagObserverOptions o = TagObserverOptions::Load(ConfigNode::LoadString(
+      "families: [tag36h11]\nquad_decimate: 1\nmodel: analytic\nmarkers:\n"
+      "  - {id: 3, size_m: 0.16, landmark: 12}\n  - {id: 7, size_m: 0.24, robot: 1}\n",
+      "tags.yaml"));
+  ASSERT_EQ(o.markers.size(), 2u);
+  EXPECT_EQ(o.markers[0].landmark, 12);
+  EXPECT_EQ(o.markers[1].carrier, TagMarker::Carrier::kRobot);
+  EXPECT_EQ(o.model.kind, TagErrorModelKind::kAnalytic);
+  EXPECT_DOUBLE_EQ(o.detector.quad_decimate, 1.0);
+  try {
+    TagObserverOptions::Load(
+        ConfigNode::LoadString("markers:\n  - {id: 3, size_m: 0.16, landmark: 1}\n  - {id: 3, "
+                               "size_m: 0.16, landmark: 2}\n",
+                               "tags.yaml"));
+    FAIL() << "a duplicate id was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("configured twice"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(TagObserverOptions::Load(ConfigNode::LoadString(
+                   "markers:\n  - {id: 600, size_m: 0.16, landmark: 1}\n", "tags.yaml")),
+               ConfigError);
+}
+
+}  // namespace
+}  // namespace rover::mapping
