@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/log/msgs/builtin_interfaces.h"
+#include "mapping/slam/graph_log.h"
 #include "mapping/tags/tag_family.h"
 
 namespace rover::mapping {
@@ -158,6 +160,38 @@ std::vector<TagObservation> TagObserver::Observe(const cv::Mat& rectified) {
     out.push_back(std::move(o));
   }
   return out;
+}
+
+log::rover_msgs::TagDetection ToMsg(const TagObservation& o, int64_t stamp_ns,
+                                    std::string_view camera_frame) {
+  log::rover_msgs::TagDetection m;
+  m.header.stamp = log::ToRosTime(Time::FromNanoseconds(stamp_ns));
+  m.header.frame_id = log::FrameId::Truncated(camera_frame);
+  m.family = o.detection.family;
+  m.id = o.detection.id;
+  m.accepted = o.accepted;
+  m.refusal = o.refusal;
+  for (std::size_t k = 0; k < 4; ++k) {
+    m.corners_px[2 * k] = o.detection.corners_px[k].x();
+    m.corners_px[2 * k + 1] = o.detection.corners_px[k].y();
+  }
+  m.decision_margin = o.detection.decision_margin;
+  m.hamming = o.detection.hamming;
+  if (o.pose) {
+    m.pose = ToPoseMsg(o.pose->best.T_camera_tag);
+    m.alternative_pose = ToPoseMsg(o.pose->alternative.T_camera_tag);
+    m.reprojection_rmse_px = o.pose->best.reprojection_rmse_px;
+    m.ambiguity_ratio = o.pose->ambiguity_ratio;
+    m.distance_m = o.pose->distance_m;
+    m.tilt_rad = o.pose->tilt_rad;
+  }
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) {
+      m.covariance[static_cast<std::size_t>(r * 6 + c)] = o.uncertainty.covariance(r, c);
+    }
+  }
+  m.flipped = static_cast<uint32_t>(o.uncertainty.perturbation.flipped);
+  return m;
 }
 
 }  // namespace rover::mapping

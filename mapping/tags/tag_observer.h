@@ -13,12 +13,14 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "core/calib/stereo_rectifier.h"
 #include "core/config/config.h"
+#include "core/log/msgs/rover_msgs.h"
 #include "mapping/tags/tag_detector.h"
 #include "mapping/tags/tag_error_model.h"
 #include "mapping/tags/tag_error_table.h"
@@ -76,6 +78,11 @@ struct TagObserverStats {
   uint64_t refused_by_model = 0;     ///< ambiguous (flips, equal fits) or degenerate
   uint64_t no_pose = 0;
 };
+
+/// The log record of one observation (header.stamp `stamp_ns`, frame_id
+/// `camera_frame`, e.g. "cam0"), so that detections can be replayed.
+log::rover_msgs::TagDetection ToMsg(const TagObservation& observation, int64_t stamp_ns,
+                                    std::string_view camera_frame);
 
 class TagObserver {
  public:

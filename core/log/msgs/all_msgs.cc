@@ -47,6 +47,7 @@ constexpr std::array kAllSchemas = {
     SchemaOf<rover_msgs::GraphFactor>(),
     SchemaOf<rover_msgs::SubmapOrigin>(),
     SchemaOf<rover_msgs::SubmapOrigins>(),
+    SchemaOf<rover_msgs::TagDetection>(),
 };
 
 }  // namespace

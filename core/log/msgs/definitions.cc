@@ -233,6 +233,23 @@ constexpr std::array kOwnTexts = {
             "std_msgs/Header header\n"
             "uint64 update\n"
             "SubmapOrigin[] origins"},
+    OwnText{"rover_msgs/TagDetection",
+            "std_msgs/Header header\n"
+            "string family\n"
+            "int32 id\n"
+            "bool accepted\n"
+            "string refusal\n"
+            "float64[8] corners_px\n"
+            "float64 decision_margin\n"
+            "int32 hamming\n"
+            "geometry_msgs/Pose pose\n"
+            "geometry_msgs/Pose alternative_pose\n"
+            "float64 reprojection_rmse_px\n"
+            "float64 ambiguity_ratio\n"
+            "float64 distance_m\n"
+            "float64 tilt_rad\n"
+            "float64[36] covariance\n"
+            "uint32 flipped"},
 };
 
 // The primitive types of the ROS 2 interface definition language.

@@ -123,6 +123,41 @@ bool Deserialize(CdrReader& reader, SubmapOrigins* msg) {
          reader.ReadSequence("origins", &msg->origins, kMinSubmapOriginSize);
 }
 
+void Serialize(const TagDetection& msg, CdrWriter& writer) {
+  Serialize(msg.header, writer);
+  writer.WriteString(msg.family);
+  writer.WriteI32(msg.id);
+  writer.WriteBool(msg.accepted);
+  writer.WriteString(msg.refusal);
+  writer.WriteF64Array(msg.corners_px);
+  writer.WriteF64(msg.decision_margin);
+  writer.WriteI32(msg.hamming);
+  Serialize(msg.pose, writer);
+  Serialize(msg.alternative_pose, writer);
+  writer.WriteF64(msg.reprojection_rmse_px);
+  writer.WriteF64(msg.ambiguity_ratio);
+  writer.WriteF64(msg.distance_m);
+  writer.WriteF64(msg.tilt_rad);
+  writer.WriteF64Array(msg.covariance);
+  writer.WriteU32(msg.flipped);
+}
+
+bool Deserialize(CdrReader& reader, TagDetection* msg) {
+  return reader.ReadNested("header", &msg->header) && reader.ReadString("family", &msg->family) &&
+         reader.ReadI32("id", &msg->id) && reader.ReadBool("accepted", &msg->accepted) &&
+         reader.ReadString("refusal", &msg->refusal) &&
+         reader.ReadF64Array("corners_px", msg->corners_px) &&
+         reader.ReadF64("decision_margin", &msg->decision_margin) &&
+         reader.ReadI32("hamming", &msg->hamming) && reader.ReadNested("pose", &msg->pose) &&
+         reader.ReadNested("alternative_pose", &msg->alternative_pose) &&
+         reader.ReadF64("reprojection_rmse_px", &msg->reprojection_rmse_px) &&
+         reader.ReadF64("ambiguity_ratio", &msg->ambiguity_ratio) &&
+         reader.ReadF64("distance_m", &msg->distance_m) &&
+         reader.ReadF64("tilt_rad", &msg->tilt_rad) &&
+         reader.ReadF64Array("covariance", msg->covariance) &&
+         reader.ReadU32("flipped", &msg->flipped);
+}
+
 }  // namespace rover_msgs
 
 std::string_view MessageTraits<rover_msgs::LogChannelHealth>::Definition() {
@@ -147,6 +182,10 @@ std::string_view MessageTraits<rover_msgs::SubmapOrigin>::Definition() {
 
 std::string_view MessageTraits<rover_msgs::SubmapOrigins>::Definition() {
   return internal::CachedDefinition<rover_msgs::SubmapOrigins>();
+}
+
+std::string_view MessageTraits<rover_msgs::TagDetection>::Definition() {
+  return internal::CachedDefinition<rover_msgs::TagDetection>();
 }
 
 }  // namespace rover::log

@@ -117,6 +117,36 @@ struct SubmapOrigins {
   friend bool operator==(const SubmapOrigins&, const SubmapOrigins&) = default;
 };
 
+/// rover_msgs/msg/TagDetection: one decoded AprilTag in a rectified image,
+/// accepted for the graph or refused with the reason (header.stamp: the
+/// image's capture; header.frame_id: the rectified camera, "cam0"). Corners
+/// x0 y0 .. x3 y3 in the library's order, OpenCV pixel centres. `pose` is
+/// the better of the two solutions of the planar ambiguity (T_camera_tag),
+/// `alternative_pose` the other; the covariance is row-major over [dt (m,
+/// camera); dtheta (rad, tag frame, right)], zero when refused before the
+/// error model. `flipped`: perturbed corner sets (of 256) whose pose fell on
+/// the other solution.
+struct TagDetection {
+  std_msgs::Header header;
+  std::string family;
+  int32_t id = 0;
+  bool accepted = false;
+  std::string refusal;
+  std::array<double, 8> corners_px{};
+  double decision_margin = 0.0;
+  int32_t hamming = 0;
+  geometry_msgs::Pose pose;
+  geometry_msgs::Pose alternative_pose;
+  double reprojection_rmse_px = 0.0;
+  double ambiguity_ratio = 0.0;
+  double distance_m = 0.0;
+  double tilt_rad = 0.0;
+  std::array<double, 36> covariance{};
+  uint32_t flipped = 0;
+
+  friend bool operator==(const TagDetection&, const TagDetection&) = default;
+};
+
 void Serialize(const LogChannelHealth& msg, CdrWriter& writer);
 void Serialize(const LogHealth& msg, CdrWriter& writer);
 void Serialize(const SubmapInfo& msg, CdrWriter& writer);
@@ -129,6 +159,8 @@ void Serialize(const SubmapOrigins& msg, CdrWriter& writer);
 bool Deserialize(CdrReader& reader, GraphFactor* msg);
 bool Deserialize(CdrReader& reader, SubmapOrigin* msg);
 bool Deserialize(CdrReader& reader, SubmapOrigins* msg);
+void Serialize(const TagDetection& msg, CdrWriter& writer);
+bool Deserialize(CdrReader& reader, TagDetection* msg);
 
 }  // namespace rover_msgs
 
@@ -165,6 +197,12 @@ struct MessageTraits<rover_msgs::SubmapOrigin> {
 template <>
 struct MessageTraits<rover_msgs::SubmapOrigins> {
   static constexpr std::string_view kName = "rover_msgs/msg/SubmapOrigins";
+  static std::string_view Definition();
+};
+
+template <>
+struct MessageTraits<rover_msgs::TagDetection> {
+  static constexpr std::string_view kName = "rover_msgs/msg/TagDetection";
   static std::string_view Definition();
 };
 

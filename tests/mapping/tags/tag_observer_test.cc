@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/config/config.h"
+#include "core/log/msgs/message_traits.h"
 #include "mapping/tags/tag_image_renderer.h"
 #include "mapping/tags/tag_pattern.h"
 #include "tests/mapping/tags/synthetic_tag_image.h"
@@ -59,6 +60,17 @@ TEST(TagObserverTest, AcceptsAConfiguredTagWithItsPoseAndCovariance) {
     EXPECT_EQ(o.marker->id, id);
     EXPECT_LT((o.pose->best.T_camera_tag.translation() - T.translation()).norm(), 0.02);
     EXPECT_GT(o.uncertainty.covariance.ldlt().vectorD().minCoeff(), 0.0);
+    // The log record carries what a replay needs, through CDR and back.
+    const auto bytes = log::SerializeMessage(ToMsg(o, 1'500'000'000, "cam0"));
+    log::rover_msgs::TagDetection m;
+    ASSERT_TRUE(log::DeserializeMessage(std::span(bytes.data(), bytes.size()), &m));
+    EXPECT_EQ(m.id, id);
+    EXPECT_TRUE(m.accepted);
+    EXPECT_EQ(std::string(m.header.frame_id.view()), "cam0");
+    EXPECT_EQ(m.header.stamp.sec, 1);
+    EXPECT_DOUBLE_EQ(m.corners_px[5], o.detection.corners_px[2].y());
+    EXPECT_DOUBLE_EQ(m.covariance[14], o.uncertainty.covariance(2, 2));
+    EXPECT_NEAR(m.pose.position.z, o.pose->best.T_camera_tag.translation().z(), 1e-12);
   }
   EXPECT_EQ(observer.stats().accepted, 2u);
   EXPECT_EQ(observer.stats().images, 2u);

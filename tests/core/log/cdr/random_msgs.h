@@ -176,6 +176,24 @@ class RandomMessages {
     m->update = rng_();
     FillVector(&m->origins);
   }
+  void Fill(rover_msgs::TagDetection* m) {
+    Fill(&m->header);
+    m->family = Text(8);
+    m->id = static_cast<int32_t>(rng_());
+    m->accepted = Uniform(0, 1) == 1;
+    m->refusal = Text(20);
+    FillArray(&m->corners_px);
+    FillArray(&m->covariance);
+    Fill(&m->pose);
+    Fill(&m->alternative_pose);
+    m->hamming = static_cast<int32_t>(Uniform(0, 3));
+    m->flipped = static_cast<uint32_t>(Uniform(0, 256));
+    m->decision_margin = Real();
+    m->reprojection_rmse_px = Real();
+    m->ambiguity_ratio = Real();
+    m->distance_m = Real();
+    m->tilt_rad = Real();
+  }
   void Fill(nav_msgs::Odometry* m) {
     Fill(&m->header);
     m->child_frame_id = FrameId::Truncated(Text(FrameId::kCapacity));
@@ -326,7 +344,7 @@ using AllMessageTypes = ::testing::Types<
     rover_msgs::EstimatorImu, rover_msgs::EstimatorEvent, rover_msgs::EstimatorRelativePose,
     rover_msgs::EstimatorWheelSpeeds, rover_msgs::EstimatorState, rover_msgs::EstimatorFrameSwitch,
     rover_msgs::SubmapInfo, rover_msgs::GraphFactor, rover_msgs::SubmapOrigin,
-    rover_msgs::SubmapOrigins>;
+    rover_msgs::SubmapOrigins, rover_msgs::TagDetection>;
 
 /// gtest names for AllMessageTypes instances: the ROS type name.
 struct MessageTypeName {
