@@ -95,6 +95,37 @@ GraphFactorRecord SubmapMatchFactor(const GraphKey& origin_a, const GraphKey& or
   return r;
 }
 
+GraphFactorRecord FilterPoseFactor(int robot, int64_t submap, int64_t pose,
+                                   const Eigen::Isometry3d& T_local_body,
+                                   const Matrix6d& covariance) {
+  GraphFactorRecord r;
+  r.kind = FactorKind::kFilterPose;
+  r.a = GraphKey::Origin(robot, submap);
+  r.b = GraphKey::Pose(robot, pose);
+  r.T_a_b = T_local_body;
+  r.covariance = covariance;
+  return r;
+}
+
+GraphFactorRecord LandmarkObservationFactor(int robot, int64_t pose, int64_t landmark,
+                                            const Eigen::Isometry3d& T_body_cam,
+                                            const Eigen::Isometry3d& T_cam_tag,
+                                            const Matrix6d& covariance_cam_tag,
+                                            const Eigen::Isometry3d& T_landmark_tag) {
+  // A landmark's tag is a marker mounted on it: the same composition as a
+  // robot detection, with the landmark in the target's place.
+  const auto [T_body_landmark, covariance] =
+      ComposeDetection(RobotDetection{T_body_cam, T_cam_tag, covariance_cam_tag, T_landmark_tag});
+  GraphFactorRecord r;
+  r.kind = FactorKind::kLandmarkObservation;
+  r.a = GraphKey::Pose(robot, pose);
+  r.b = GraphKey::Landmark(landmark);
+  r.T_a_b = T_body_landmark;
+  r.covariance = covariance;
+  r.robust = true;
+  return r;
+}
+
 void AddToGraph(const GraphFactorRecord& r, RoverGraph* graph) {
   using Type = GraphKey::Type;
   const bool binary = r.b.has_value();

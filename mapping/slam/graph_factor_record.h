@@ -67,6 +67,23 @@ GraphFactorRecord FrameSwitchFactor(int robot, int64_t old_frame,
 GraphFactorRecord SubmapMatchFactor(const GraphKey& origin_a, const GraphKey& origin_b,
                                     const Eigen::Isometry3d& T_a_b, const Matrix6d& covariance);
 
+/// v: the filter's estimate T_local_body of pose x^robot_pose in the local
+/// frame of origin s^robot_submap, with its covariance (the graph's
+/// convention, [dp (local); dtheta (right)]).
+GraphFactorRecord FilterPoseFactor(int robot, int64_t submap, int64_t pose,
+                                   const Eigen::Isometry3d& T_local_body,
+                                   const Matrix6d& covariance);
+
+/// o: robot pose x^robot_pose sees landmark l_landmark through a tag:
+/// T_body_landmark = T_body_cam * T_cam_tag * T_landmark_tag^-1, with the
+/// tag pose's covariance (over [dt (camera); dtheta (tag, right)])
+/// propagated to first order (ComposeDetection). Robust.
+GraphFactorRecord LandmarkObservationFactor(int robot, int64_t pose, int64_t landmark,
+                                            const Eigen::Isometry3d& T_body_cam,
+                                            const Eigen::Isometry3d& T_cam_tag,
+                                            const Matrix6d& covariance_cam_tag,
+                                            const Eigen::Isometry3d& T_landmark_tag);
+
 /// Adds `record` to `graph` through the matching RoverGraph call. Throws
 /// GraphError (naming the factor) for NaN, a covariance that is not
 /// positive definite, or keys that do not fit the kind.
