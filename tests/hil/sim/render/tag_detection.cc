@@ -12,6 +12,7 @@ std::vector<Detection> DetectTags(const cv::Mat& image) {
   options.min_decision_margin = 0.0;
   options.border_margin_px = 0.0;
   options.min_area_px2 = 1e-6;
+  options.quad_decimate = 1.0;  // full resolution: the farthest tags too
   mapping::TagDetector detector(options);
   std::vector<Detection> out;
   for (const mapping::TagDetection& d : detector.Detect(image)) {
