@@ -15,9 +15,8 @@ namespace rover::host {
 
 std::string TagErrorTablePath(const std::string& calibration, const std::string& family,
                               double tag_size_m) {
-  const auto mm = static_cast<long long>(std::llround(tag_size_m * 1000.0));
   return (std::filesystem::path(calibration).parent_path() /
-          ("tag_errors_" + family + "_" + std::to_string(mm) + "mm.yaml"))
+          mapping::TagErrorTableFileName(family, tag_size_m))
       .string();
 }
 

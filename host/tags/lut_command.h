@@ -21,8 +21,8 @@ struct LutCommandOptions {
   bool progress_tty = false;  ///< draw the progress bar in place
 };
 
-/// The table's default path: beside `calibration`,
-/// "tag_errors_<family>_<size in mm>mm.yaml".
+/// The table's default path: beside `calibration`, named by
+/// mapping::TagErrorTableFileName.
 std::string TagErrorTablePath(const std::string& calibration, const std::string& family,
                               double tag_size_m);
 

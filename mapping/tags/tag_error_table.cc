@@ -105,6 +105,11 @@ double Median(std::vector<double>* v) {
 
 }  // namespace
 
+std::string TagErrorTableFileName(const std::string& family, double tag_size_m) {
+  return "tag_errors_" + family + "_" + std::to_string(std::llround(tag_size_m * 1000.0)) +
+         "mm.yaml";
+}
+
 void TagErrorTableSpec::Validate() const {
   constexpr const char* kName = "TagErrorTableSpec";
   CheckPositive(kName, "camera.fx", camera.fx);

@@ -47,6 +47,11 @@ struct TagErrorTableSpec {
   void Validate() const;
 };
 
+/// The table's file name for `family` and `tag_size_m`:
+/// "tag_errors_<family>_<size in mm>mm.yaml". rover-tags writes it beside the
+/// board's calibration, where mapd looks for it.
+std::string TagErrorTableFileName(const std::string& family, double tag_size_m);
+
 class TagErrorTable {
  public:
   /// An empty table (every cell undetected) on `spec`'s grid.
