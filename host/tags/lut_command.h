@@ -3,7 +3,7 @@
 
 // `rover-tags lut`: builds the tag detection error table (mapping/tags) for
 // a board's rectified stereo camera, a tag family and a tag size, and writes
-// it next to the board's calibration, where mapd looks for it.
+// it next to the board's calibration.
 
 #include <ostream>
 #include <string>

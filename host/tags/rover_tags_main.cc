@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
       "error table of the thesis's model (maximum pose errors over distance and tilt, from tags\n"
       "rendered at each grid pose, detected, their corners perturbed by +-delta px in all 256\n"
       "combinations) for a board's rectified camera, a family and a tag size, and writes it\n"
-      "next to the board's calibration, where mapd reads it."};
+      "next to the board's calibration."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rover-tags 0.1.0");
 

@@ -49,7 +49,7 @@ struct TagErrorTableSpec {
 
 /// The table's file name for `family` and `tag_size_m`:
 /// "tag_errors_<family>_<size in mm>mm.yaml". rover-tags writes it beside the
-/// board's calibration, where mapd looks for it.
+/// board's calibration.
 std::string TagErrorTableFileName(const std::string& family, double tag_size_m);
 
 class TagErrorTable {
