@@ -134,7 +134,6 @@ std::vector<TagDetection> TagDetector::Detect(const cv::Mat& mono8,
     }
     d.centre_px = Eigen::Vector2d(det->c[0] - kLibraryPixelCentreOffsetPx,
                                   det->c[1] - kLibraryPixelCentreOffsetPx);
-    std::string reason;
     std::ostringstream why;
     bool inside = true;
     for (const Eigen::Vector2d& c : d.corners_px) {
@@ -142,17 +141,18 @@ std::vector<TagDetection> TagDetector::Detect(const cv::Mat& mono8,
           inside && c.allFinite() && c.x() >= m && c.y() >= m && c.x() <= w - m && c.y() <= h - m;
     }
     const double area = 0.5 * std::abs(SignedArea2(d.corners_px));
+    const bool convex = Convex(d.corners_px);
     if (d.hamming > options_.max_hamming) {
       why << d.hamming << " bits corrected (at most " << options_.max_hamming << ")";
     } else if (d.decision_margin < options_.min_decision_margin) {
       why << "decision margin " << d.decision_margin << " below " << options_.min_decision_margin;
     } else if (!inside) {
       why << "cut by the image border (a corner within " << m << " px of it)";
-    } else if (!Convex(d.corners_px) || !(area >= options_.min_area_px2)) {
-      why << "degenerate quad (area " << area << " px^2, "
-          << (Convex(d.corners_px) ? "convex" : "not convex") << ")";
+    } else if (!convex || !(area >= options_.min_area_px2)) {
+      why << "degenerate quad (area " << area << " px^2, " << (convex ? "convex" : "not convex")
+          << ")";
     }
-    reason = why.str();
+    const std::string reason = why.str();
     if (reason.empty()) {
       out.push_back(std::move(d));
     } else if (refused != nullptr) {

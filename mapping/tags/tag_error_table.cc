@@ -82,14 +82,9 @@ TagPoseErrors BuildCell(const TagErrorTableSpec& spec, const TagPattern& pattern
   TagPoseErrors worst = TagPoseErrors::Zero();
   bool any = false;
   for (unsigned signs = 0; signs <= 256; ++signs) {  // 256: unperturbed
-    std::array<Eigen::Vector2d, 4> c = corners;
-    if (signs < 256) {
-      for (unsigned k = 0; k < 8; ++k) {
-        c[k / 2][static_cast<int>(k % 2)] +=
-            (signs >> k) & 1u ? spec.corner_delta_px : -spec.corner_delta_px;
-      }
-    }
-    const std::optional<TagPoseErrors> e = ClosestSolutionError(c, spec, truth);
+    const std::optional<TagPoseErrors> e = ClosestSolutionError(
+        signs < 256 ? PerturbedCorners(corners, spec.corner_delta_px, signs) : corners, spec,
+        truth);
     if (!e) continue;
     worst = worst.cwiseMax(e->cwiseAbs());
     any = true;
@@ -205,8 +200,8 @@ void TagErrorTable::PostProcess() {
     for (int j = last + 1; j < nt; ++j) At(i, j) = At(i, last);
     for (int j = first + 1; j < last; ++j) {  // holes inside: the larger neighbour's
       if (!std::isnan(At(i, j)[0])) continue;
-      At(i, j) =
-          At(i, j - 1).cwiseMax(At(i, j + 1).array().isNaN().any() ? At(i, j - 1) : At(i, j + 1));
+      const TagPoseErrors& next = At(i, j + 1);  // NaN while the hole goes on
+      At(i, j) = std::isnan(next[0]) ? At(i, j - 1) : At(i, j - 1).cwiseMax(next);
     }
   }
   // Each tilt column: the rest with the maximum of the last 10 % of its

@@ -17,6 +17,15 @@ TagPoseErrors TagPoseError(const Eigen::Isometry3d& estimate, const Eigen::Isome
   return e;
 }
 
+std::array<Eigen::Vector2d, 4> PerturbedCorners(const std::array<Eigen::Vector2d, 4>& corners_px,
+                                                double delta_px, unsigned signs) {
+  std::array<Eigen::Vector2d, 4> c = corners_px;
+  for (unsigned k = 0; k < 8; ++k) {
+    c[k / 2][static_cast<int>(k % 2)] += (signs >> k) & 1u ? delta_px : -delta_px;
+  }
+  return c;
+}
+
 CornerPerturbation PerturbCorners(const std::array<Eigen::Vector2d, 4>& corners_px,
                                   double tag_size_m, const calib::RectifiedIntrinsics& camera,
                                   double delta_px, double flip_angle_rad) {
@@ -30,12 +39,8 @@ CornerPerturbation PerturbCorners(const std::array<Eigen::Vector2d, 4>& corners_
   std::vector<TagPoseErrors> offsets{TagPoseErrors::Zero()};
   offsets.reserve(257);
   for (unsigned signs = 0; signs < 256; ++signs) {
-    std::array<Eigen::Vector2d, 4> c = corners_px;
-    for (unsigned k = 0; k < 8; ++k) {
-      const double d = (signs >> k) & 1u ? delta_px : -delta_px;
-      c[k / 2][static_cast<int>(k % 2)] += d;
-    }
-    const std::optional<TagPose> p = EstimateTagPose(c, tag_size_m, camera, &error);
+    const std::optional<TagPose> p =
+        EstimateTagPose(PerturbedCorners(corners_px, delta_px, signs), tag_size_m, camera, &error);
     if (!p) continue;
     const TagPoseErrors offset = TagPoseError(T0, p->best.T_camera_tag);
     if (offset.tail<3>().norm() > flip_angle_rad) ++out.flipped;

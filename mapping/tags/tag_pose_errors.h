@@ -22,6 +22,12 @@ using TagPoseErrors = Eigen::Matrix<double, 6, 1>;
 /// The error of `estimate` against `truth` in that parametrisation.
 TagPoseErrors TagPoseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
 
+/// Perturbation `signs` (0..255) of the thesis's 2^8: each of the eight
+/// corner coordinates (x0 y0 .. x3 y3, bit k for coordinate k) moved by
+/// +delta_px where its bit is set, -delta_px where not.
+std::array<Eigen::Vector2d, 4> PerturbedCorners(const std::array<Eigen::Vector2d, 4>& corners_px,
+                                                double delta_px, unsigned signs);
+
 struct CornerPerturbation {
   /// Largest deviation per degree of freedom from the mean of all solved
   /// poses (the unperturbed one and the 256 perturbed).
