@@ -30,10 +30,6 @@ Eigen::Isometry3d Perturbed(const Eigen::Isometry3d& T, const TagPoseErrors& del
   return out;
 }
 
-Matrix6d Diagonal(const TagPoseErrors& sigma) {
-  return sigma.array().square().matrix().asDiagonal();
-}
-
 }  // namespace
 
 void TagErrorModelOptions::Validate() const {
@@ -91,14 +87,35 @@ TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& cor
         << " (at most " << options_.max_ambiguity_ratio << ")";
   }
   u.refusal = why.str();
+  u.ambiguous = u.perturbation.solved > 0 && !u.refusal.empty();
   if (!u.refusal.empty()) return u;
   if (options_.kind == TagErrorModelKind::kTable) {
     const TagPoseErrors base = table_->Lookup(pose.distance_m, pose.tilt_rad);
     u.sigma = options_.sigma_per_max_error * base.cwiseMax(u.perturbation.max_deviation);
-    u.covariance = Diagonal(u.sigma);
+    u.covariance = LineOfSightCovariance(u.sigma, pose.best.T_camera_tag.translation());
   } else {
     u.covariance =
         AnalyticTagCovariance(pose.best.T_camera_tag, tag_size_m, camera, options_.corner_sigma_px);
+    u.sigma = u.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  }
+  if (!u.covariance.allFinite() || !(u.sigma.array() > 0.0).all()) {
+    u.refusal = "degenerate covariance";
+    return u;
+  }
+  u.accepted = true;
+  return u;
+}
+
+TagUncertainty TagErrorModel::ForSolution(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
+                                          const calib::RectifiedIntrinsics& camera) const {
+  TagUncertainty u;
+  if (options_.kind == TagErrorModelKind::kTable) {
+    u.sigma = options_.sigma_per_max_error *
+              table_->Lookup(T_camera_tag.translation().norm(), TagTilt(T_camera_tag));
+    u.covariance = LineOfSightCovariance(u.sigma, T_camera_tag.translation());
+  } else {
+    u.covariance =
+        AnalyticTagCovariance(T_camera_tag, tag_size_m, camera, options_.corner_sigma_px);
     u.sigma = u.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   }
   if (!u.covariance.allFinite() || !(u.sigma.array() > 0.0).all()) {

@@ -58,9 +58,16 @@ struct TagErrorModelOptions {
 
 struct TagUncertainty {
   bool accepted = false;
+  /// Refused because the two solutions cannot be told apart from this image
+  /// alone (flips under the perturbation, or equal fits); the tag's other
+  /// sightings may still decide (TagAmbiguityResolver).
+  bool ambiguous = false;
   std::string refusal;  ///< why, when not accepted
   Matrix6d covariance = Matrix6d::Zero();
-  TagPoseErrors sigma = TagPoseErrors::Zero();  ///< sqrt of the diagonal
+  /// Standard deviations: the table model's across and along the line of
+  /// sight (LineOfSightCovariance), the analytic model's the covariance's
+  /// diagonal.
+  TagPoseErrors sigma = TagPoseErrors::Zero();
   CornerPerturbation perturbation;
 };
 
@@ -77,6 +84,13 @@ class TagErrorModel {
 
   TagUncertainty Evaluate(const std::array<Eigen::Vector2d, 4>& corners_px, const TagPose& pose,
                           double tag_size_m, const calib::RectifiedIntrinsics& camera) const;
+
+  /// The covariance of one solution chosen by other means (an ambiguous
+  /// detection that the tag's other sightings decide): the table at that
+  /// solution's distance and tilt, or the analytic model; no perturbation
+  /// and no ambiguity check. Not accepted only if degenerate.
+  TagUncertainty ForSolution(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
+                             const calib::RectifiedIntrinsics& camera) const;
 
   const TagErrorModelOptions& options() const { return options_; }
 

@@ -2,7 +2,9 @@
 
 #include <apriltag/apriltag.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -90,6 +92,58 @@ TagObserverOptions TagObserverOptions::Load(const ConfigNode& node) {
   return o;
 }
 
+std::vector<TagErrorTable> LoadTagErrorTables(const TagObserverOptions& options,
+                                              const calib::RectifiedIntrinsics& camera,
+                                              cv::Size image_size, const std::string& directory,
+                                              bool build_missing,
+                                              const std::function<void(const std::string&)>& say,
+                                              const TagErrorTableSpec& grid) {
+  std::vector<TagErrorTable> tables;
+  if (options.model.kind != TagErrorModelKind::kTable) return tables;
+  const std::string& family = options.detector.families.at(0);
+  std::set<int64_t> sizes;
+  for (const TagMarker& m : options.markers) {
+    if (!sizes.insert(SizeKey(m.size_m)).second) continue;
+    const std::string path =
+        (std::filesystem::path(directory) / TagErrorTableFileName(family, m.size_m)).string();
+    std::string problem;
+    try {
+      TagErrorTable table = TagErrorTable::Load(path);
+      table.CheckMatches(camera, image_size, family, m.size_m);
+      if (say) say("tag error table " + path);
+      tables.push_back(std::move(table));
+      continue;
+    } catch (const std::exception& e) {
+      problem = e.what();
+    }
+    if (!build_missing) {
+      std::ostringstream command;
+      command << problem
+              << " (make it with: rover-tags lut --calibration <the board's calibration> "
+              << "--family " << family << " --tag-size-m " << m.size_m << " --out " << path << ")";
+      throw std::runtime_error(command.str());
+    }
+    TagErrorTableSpec spec = grid;
+    spec.camera = camera;
+    spec.image_size = image_size;
+    spec.family = family;
+    spec.tag_size_m = m.size_m;
+    spec.corner_delta_px = options.model.corner_delta_px;
+    if (say) say(problem + ": building it");
+    const auto start = std::chrono::steady_clock::now();
+    TagErrorTable table = TagErrorTable::Build(spec);
+    std::filesystem::create_directories(directory);
+    table.Save(path);
+    if (say) {
+      const double s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      say("tag error table " + path + " built in " + std::to_string(static_cast<int>(s)) + " s");
+    }
+    tables.push_back(std::move(table));
+  }
+  return tables;
+}
+
 TagObserver::TagObserver(const TagObserverOptions& options,
                          const calib::RectifiedIntrinsics& camera, cv::Size image_size,
                          const std::vector<TagErrorTable>& tables)
@@ -143,8 +197,13 @@ std::vector<TagObservation> TagObserver::Observe(const cv::Mat& rectified) {
       out.push_back(std::move(o));
       continue;
     }
-    o.uncertainty = models_.at(SizeKey(o.marker->size_m))
-                        .Evaluate(d.corners_px, *o.pose, o.marker->size_m, camera_);
+    const TagErrorModel& model = models_.at(SizeKey(o.marker->size_m));
+    o.uncertainty = model.Evaluate(d.corners_px, *o.pose, o.marker->size_m, camera_);
+    if (o.uncertainty.ambiguous) {
+      o.solutions = {
+          model.ForSolution(o.pose->best.T_camera_tag, o.marker->size_m, camera_),
+          model.ForSolution(o.pose->alternative.T_camera_tag, o.marker->size_m, camera_)};
+    }
     o.accepted = o.uncertainty.accepted;
     o.refusal = o.uncertainty.refusal;
     (o.accepted ? stats_.accepted : stats_.refused_by_model)++;

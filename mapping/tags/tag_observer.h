@@ -9,7 +9,9 @@
 // status. Not thread-safe: one observer per thread.
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -67,6 +69,10 @@ struct TagObservation {
   TagUncertainty uncertainty;
   bool accepted = false;
   std::string refusal;  ///< why not, when not accepted
+  /// Ambiguous detections only (uncertainty.ambiguous): the covariance of
+  /// each solution (best, alternative), should the tag's other sightings
+  /// decide between them.
+  std::array<TagUncertainty, 2> solutions{};
 };
 
 struct TagObserverStats {
@@ -83,6 +89,19 @@ struct TagObserverStats {
 /// `camera_frame`, e.g. "cam0"), so that detections can be replayed.
 log::rover_msgs::TagDetection ToMsg(const TagObservation& observation, int64_t stamp_ns,
                                     std::string_view camera_frame);
+
+/// The error tables `options` needs (one per marker size; none for the
+/// analytic model) for `camera` at `image_size`, read from `directory`
+/// (TagErrorTableFileName). A table that is missing, unreadable or made for
+/// another camera is built on `grid`'s distances and tilts (the default:
+/// 60 x 60, a few seconds per table) and saved there when `build_missing` is
+/// set; otherwise
+/// std::runtime_error names the file, what is wrong and the rover-tags
+/// command that makes it. `say` gets one line per table read or built.
+std::vector<TagErrorTable> LoadTagErrorTables(
+    const TagObserverOptions& options, const calib::RectifiedIntrinsics& camera,
+    cv::Size image_size, const std::string& directory, bool build_missing,
+    const std::function<void(const std::string&)>& say = {}, const TagErrorTableSpec& grid = {});
 
 class TagObserver {
  public:

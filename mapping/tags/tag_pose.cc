@@ -106,15 +106,18 @@ std::optional<TagPose> EstimateTagPose(const std::array<Eigen::Vector2d, 4>& cor
   pose.alternative = found.size() > 1 ? found[1] : found[0];
   const double alt = pose.alternative.reprojection_rmse_px;
   pose.ambiguity_ratio = alt > 0.0 ? pose.best.reprojection_rmse_px / alt : 1.0;
-  const Eigen::Vector3d t = pose.best.T_camera_tag.translation();
-  pose.distance_m = t.norm();
+  pose.distance_m = pose.best.T_camera_tag.translation().norm();
+  pose.tilt_rad = TagTilt(pose.best.T_camera_tag);
+  return pose;
+}
+
+double TagTilt(const Eigen::Isometry3d& T_camera_tag) {
   // The tag's z points into the tag, away from a camera that reads it.
-  const Eigen::Vector3d normal_to_camera = -pose.best.T_camera_tag.linear().col(2);
-  const Eigen::Vector3d to_camera = -t.normalized();
+  const Eigen::Vector3d normal_to_camera = -T_camera_tag.linear().col(2);
+  const Eigen::Vector3d to_camera = -T_camera_tag.translation().normalized();
   const double cos_tilt = std::clamp(normal_to_camera.dot(to_camera), -1.0, 1.0);
   const Eigen::Vector3d across = normal_to_camera - cos_tilt * to_camera;
-  pose.tilt_rad = std::acos(cos_tilt) * (across.x() >= 0.0 ? 1.0 : -1.0);
-  return pose;
+  return std::acos(cos_tilt) * (across.x() >= 0.0 ? 1.0 : -1.0);
 }
 
 }  // namespace rover::mapping

@@ -38,6 +38,9 @@ struct TagPose {
   double tilt_rad = 0.0;
 };
 
+/// Tilt Phi of a tag at T_camera_tag, as TagPose::tilt_rad [rad].
+double TagTilt(const Eigen::Isometry3d& T_camera_tag);
+
 /// The tag's pose in the camera frame (x right, y down, z forward) from its
 /// corners (TagDetection order), its side length [m] (the black square) and
 /// the rectified intrinsics. Returns nullopt and sets `error` for a

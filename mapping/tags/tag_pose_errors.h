@@ -22,6 +22,21 @@ using TagPoseErrors = Eigen::Matrix<double, 6, 1>;
 /// The error of `estimate` against `truth` in that parametrisation.
 TagPoseErrors TagPoseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
 
+/// R_camera_ray: the line-of-sight frame of a tag at `p_camera_tag` (its z
+/// along the line of sight, its x in the plane of the camera's x and the
+/// line of sight). A tag's position is known far better across the line of
+/// sight than along it, whatever the tag's place in the image: the error
+/// table and the perturbation spread hold position errors in this frame
+/// (the camera frame for a tag on the optical axis, as the table renders
+/// them), and the covariance turns them into the camera frame.
+Eigen::Matrix3d LineOfSightRotation(const Eigen::Vector3d& p_camera_tag);
+
+/// The covariance over [dt (camera); dtheta (tag)] of standard deviations
+/// `sigma` = [across x, across y, along the line of sight (m); droll dpitch
+/// dyaw (rad, tag)] for a tag at `p_camera_tag`.
+Eigen::Matrix<double, 6, 6> LineOfSightCovariance(const TagPoseErrors& sigma,
+                                                  const Eigen::Vector3d& p_camera_tag);
+
 /// Perturbation `signs` (0..255) of the thesis's 2^8: each of the eight
 /// corner coordinates (x0 y0 .. x3 y3, bit k for coordinate k) moved by
 /// +delta_px where its bit is set, -delta_px where not.
@@ -30,7 +45,8 @@ std::array<Eigen::Vector2d, 4> PerturbedCorners(const std::array<Eigen::Vector2d
 
 struct CornerPerturbation {
   /// Largest deviation per degree of freedom from the mean of all solved
-  /// poses (the unperturbed one and the 256 perturbed).
+  /// poses (the unperturbed one and the 256 perturbed); the position in the
+  /// unperturbed pose's line-of-sight frame (LineOfSightRotation).
   TagPoseErrors max_deviation = TagPoseErrors::Zero();
   int solved = 0;  ///< of 257
   /// Perturbed samples whose best pose fell on the other branch of the

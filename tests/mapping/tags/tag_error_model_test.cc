@@ -89,7 +89,31 @@ TEST(TagErrorModelTest, TheTableModelTakesTheLargerOfTableAndSpread) {
       0.35 *
       Table().Lookup(pose->distance_m, pose->tilt_rad).cwiseMax(u.perturbation.max_deviation);
   EXPECT_TRUE(u.sigma.isApprox(expected));
-  EXPECT_TRUE(u.covariance.isApprox(Matrix6d(expected.array().square().matrix().asDiagonal())));
+  // Position sigmas across and along the line of sight, turned into the
+  // camera frame: along the line of sight the variance is the third.
+  const Eigen::Vector3d ray = pose->best.T_camera_tag.translation().normalized();
+  const Eigen::Matrix3d position_cov = u.covariance.topLeftCorner(3, 3);
+  EXPECT_NEAR(ray.dot(position_cov * ray), expected(2) * expected(2), 1e-12);
+  EXPECT_TRUE(LineOfSightRotation(ray).col(2).isApprox(ray));
+  const Eigen::Matrix3d position = u.covariance.topLeftCorner(3, 3);
+  EXPECT_TRUE(position.isApprox(position.transpose()));
+  const Eigen::Matrix3d rotation = u.covariance.bottomRightCorner(3, 3);
+  const Eigen::Vector3d rotation_variance = expected.tail(3).array().square();
+  EXPECT_TRUE(rotation.isApprox(Eigen::Matrix3d(rotation_variance.asDiagonal())));
+  EXPECT_TRUE(u.covariance.topRightCorner(3, 3).isZero());
+}
+
+TEST(TagErrorModelTest, ALineOfSightFrameIsARotationAlongTheLineOfSight) {
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0.0, 0.0, 3.0), Eigen::Vector3d(1.0, -0.4, 2.0),
+                                   Eigen::Vector3d(-2.0, 0.5, 0.5)}) {
+    const Eigen::Matrix3d R = LineOfSightRotation(p);
+    EXPECT_TRUE((R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
+    EXPECT_TRUE(R.col(2).isApprox(p.normalized()));
+    // x lies in the plane of the camera's x and the line of sight.
+    EXPECT_NEAR(R.col(0).dot(Eigen::Vector3d::UnitX().cross(p)), 0.0, 1e-12);
+  }
+  EXPECT_TRUE(LineOfSightRotation(Eigen::Vector3d(0, 0, 1)).isApprox(Eigen::Matrix3d::Identity()));
 }
 
 TEST(TagErrorModelTest, AnUnstablePoseIsRefusedAsAmbiguous) {

@@ -9,6 +9,7 @@
 #include "mapping/tags/tag_image_renderer.h"
 #include "mapping/tags/tag_pattern.h"
 #include "tests/mapping/tags/synthetic_tag_image.h"
+#include "tests/support/temp_dir.h"
 
 namespace rover::mapping {
 namespace {
@@ -133,6 +134,74 @@ TEST(TagObserverTest, LoadsItsConfigurationAndNamesWhatIsWrong) {
   EXPECT_THROW(TagObserverOptions::Load(ConfigNode::LoadString(
                    "markers:\n  - {id: 600, size_m: 0.16, landmark: 1}\n", "tags.yaml")),
                ConfigError);
+}
+
+TEST(LoadTagErrorTablesTest, ReadsTheTableOfEachSizeFromTheFolder) {
+  const rover::testing::TempDir dir("tag_tables");
+  const std::string folder = dir.path().string();
+  for (const TagErrorTable& t : Tables()) {
+    t.Save(folder + "/" + TagErrorTableFileName("tag36h11", t.spec().tag_size_m));
+  }
+  std::vector<std::string> said;
+  const std::vector<TagErrorTable> tables =
+      LoadTagErrorTables(TwoMarkers(), TestCamera(), kImage, folder, false,
+                         [&](const std::string& line) { said.push_back(line); });
+  ASSERT_EQ(tables.size(), 2u);
+  EXPECT_DOUBLE_EQ(tables[0].spec().tag_size_m, 0.16);
+  EXPECT_DOUBLE_EQ(tables[1].spec().tag_size_m, 0.24);
+  EXPECT_EQ(said.size(), 2u);
+  // The analytic model needs none.
+  TagObserverOptions analytic = TwoMarkers();
+  analytic.model.kind = TagErrorModelKind::kAnalytic;
+  EXPECT_TRUE(LoadTagErrorTables(analytic, TestCamera(), kImage, folder, false).empty());
+}
+
+TEST(LoadTagErrorTablesTest, AMissingOrForeignTableIsRefusedWithTheCommandThatMakesIt) {
+  const rover::testing::TempDir dir("tag_tables");
+  const std::string folder = dir.path().string();
+  try {
+    LoadTagErrorTables(TwoMarkers(), TestCamera(), kImage, folder, false);
+    FAIL() << "no table, no build, yet no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("tag_errors_tag36h11_160mm.yaml"), std::string::npos) << what;
+    EXPECT_NE(what.find("rover-tags lut"), std::string::npos) << what;
+    EXPECT_NE(what.find("--tag-size-m 0.16"), std::string::npos) << what;
+  }
+  // Tables for another camera (another focal length) are refused as well.
+  calib::RectifiedIntrinsics other = TestCamera();
+  other.fx += 20.0;
+  other.fy += 20.0;
+  for (const TagErrorTable& t : Tables()) {
+    t.Save(folder + "/" + TagErrorTableFileName("tag36h11", t.spec().tag_size_m));
+  }
+  try {
+    LoadTagErrorTables(TwoMarkers(), other, kImage, folder, false);
+    FAIL() << "a table for another camera was taken";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("another camera"), std::string::npos) << e.what();
+  }
+}
+
+TEST(LoadTagErrorTablesTest, BuildsAndKeepsAMissingTableWhenAskedTo) {
+  const rover::testing::TempDir dir("tag_tables");
+  const std::string folder = dir.path().string() + "/tables";
+  TagObserverOptions one = TwoMarkers();
+  one.markers.resize(1);  // one size: one table to build
+  TagErrorTableSpec grid;
+  grid.distance_steps = 8;
+  grid.tilt_steps = 9;
+  const std::vector<TagErrorTable> built =
+      LoadTagErrorTables(one, TestCamera(), kImage, folder, true, {}, grid);
+  EXPECT_EQ(built.at(0).spec().distance_steps, 8);
+  ASSERT_EQ(built.size(), 1u);
+  EXPECT_GT(built[0].detected_cells(), 0u);
+  // The second time it is read, not built: the same cells.
+  const std::vector<TagErrorTable> read =
+      LoadTagErrorTables(one, TestCamera(), kImage, folder, false);
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_NEAR(read[0].Lookup(2.0, 0.3)(0), built[0].Lookup(2.0, 0.3)(0), 1e-9);
+  EXPECT_NO_THROW(TagObserver(one, TestCamera(), kImage, read));
 }
 
 }  // namespace
