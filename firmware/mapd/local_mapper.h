@@ -79,6 +79,11 @@ class LocalMapper {
   void ResetTraversability();
   /// Pose of the rectified left camera on the body.
   const Eigen::Isometry3d& T_body_cam() const { return T_body_cam_; }
+  /// The rectified left camera's pinhole and image size.
+  const calib::RectifiedIntrinsics& rectified_intrinsics() const { return rectifier_.intrinsics(); }
+  cv::Size rectified_size() const { return rectifier_.image_size(); }
+  /// The latest rectified left image (empty before the first Process).
+  const cv::Mat& rectified_left() const { return rect0_; }
   /// The latest depth image (for tests and tools).
   const mapping::DepthImage* last_depth() const { return has_depth_ ? &depth_ : nullptr; }
   /// The latest image's obstacle flags per pixel (row-major, 1: obstacle).

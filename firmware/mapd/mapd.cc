@@ -18,6 +18,7 @@
 #include "firmware/mapd/submap_archive.h"
 #include "mapping/slam/graph_factor_record.h"
 #include "mapping/slam/graph_log.h"
+#include "mapping/tags/tag_log.h"
 
 namespace rover::mapd {
 namespace {
@@ -104,6 +105,9 @@ StampedPose PoseOf(const topics::PoseMsg& m) {
   p.T_local_body.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
   p.T_local_body.translation() =
       Eigen::Vector3d(m.p_local_body_m[0], m.p_local_body_m[1], m.p_local_body_m[2]);
+  for (int i = 0; i < 36; ++i) {
+    p.covariance(i / 6, i % 6) = m.pose_covariance[static_cast<std::size_t>(i)];
+  }
   return p;
 }
 
@@ -142,6 +146,12 @@ void MapdOptions::Validate() const {
     throw std::invalid_argument("MapdOptions.traversability_period: expected > 0 s");
   }
   local_mapper.Validate();
+  if (tags) {
+    if (!mapping)
+      throw std::invalid_argument("MapdOptions.tags: needs mapping (the rectified images)");
+    tags->Validate();
+    tag_ambiguity.Validate();
+  }
   switch_noise.Validate();
   submap.Validate();
   loop.Validate();
@@ -161,7 +171,8 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
       // History 1: whoever connects later sees mapd's state at once.
       status_(Advertise<topics::MapdStatusMsg>(transport, topics::kMapdStatusTopic, 1)),
       frame_buffer_(std::make_unique<topics::StereoFrameMsg>()),
-      history_(options.pose_history) {
+      history_(options.pose_history),
+      tag_resolver_(options.tag_ambiguity) {
   if (options_.mapping) {
     std::string error;
     // History 1: roverd published the calibration once, maybe long ago.
@@ -230,6 +241,7 @@ int Mapd::Poll() {
   }
   TryMapPending();
   if (loop_) TakeLoopMatches();
+  if (tags_) TakeTagResults();
   if (slam_) TakeSlamSnapshot();
   if (poses_->HasMissedData()) ++stats_.missed;
   if (frames_->HasMissedData()) ++stats_.missed;
@@ -385,6 +397,7 @@ void Mapd::TakeCalibration() {
         std::make_unique<LocalMapper>(options_.local_mapper, CameraOf(m.cam0), CameraOf(m.cam1));
     std::fprintf(stderr, "mapd: stereo calibration received (%dx%d px): mapping\n", m.cam0.width_px,
                  m.cam0.height_px);
+    StartTags();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mapd: cannot map with roverd's stereo calibration: %s\n", e.what());
     calibration_.reset();  // do not retry every poll
@@ -435,6 +448,12 @@ void Mapd::MapPair(const topics::StereoFrameMsg& frame, const StampedPose& pose)
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   ++stats_.images_mapped;
   last_mapped_capture_ = Time::FromNanoseconds(frame.capture_stamp_ns);
+  if (tags_) {
+    tags_->Submit(mapper_->rectified_left(), {.stamp_ns = frame.capture_stamp_ns,
+                                              .frame_id = pose.frame_id,
+                                              .T_local_body = pose.T_local_body,
+                                              .covariance = pose.covariance});
+  }
   if (!last_traversability_ ||
       *last_mapped_capture_ - *last_traversability_ >= options_.traversability_period) {
     LogTraversability(frame.capture_stamp_ns);
@@ -532,18 +551,15 @@ void Mapd::LogMemory(int64_t stamp_ns) {
 void Mapd::HandLatestPose() {
   if (!latest_pose_) return;
   last_global_pose_handed_ = Time::Now();
-  const topics::PoseMsg& pose = *latest_pose_;
-  mapping::Matrix6d covariance;
-  for (int i = 0; i < 36; ++i) {
-    covariance(i / 6, i % 6) = pose.pose_covariance[static_cast<std::size_t>(i)];
-  }
-  slam_->SetFilterPose(pose.stamp_ns, pose.frame_id, PoseOf(pose).T_local_body, covariance);
+  const StampedPose pose = PoseOf(*latest_pose_);
+  slam_->SetFilterPose(pose.stamp.nanoseconds(), pose.frame_id, pose.T_local_body, pose.covariance);
   latest_pose_.reset();
 }
 
 void Mapd::EnsurePrior(uint32_t frame_id, int64_t stamp_ns) {
   if (prior_added_) return;
   prior_added_ = true;
+  prior_frame_ = frame_id;
   // The rover's world frame is the first local frame the graph sees; a tight
   // prior fixes the gauge without pulling on anything else.
   mapping::GraphFactorRecord prior =
@@ -590,7 +606,10 @@ void Mapd::DecideResume(const topics::FrameSwitchMsg* record) {
                resume_candidate_->factors.size());
   for (std::size_t k = 0; k < resume_candidate_->factors.size(); ++k) {
     const mapping::GraphFactorRecord& f = resume_candidate_->factors[k];
-    if (f.kind == mapping::FactorKind::kPrior) prior_added_ = true;
+    if (f.kind == mapping::FactorKind::kPrior) {
+      prior_added_ = true;
+      prior_frame_ = f.a.index;
+    }
     if (f.kind == mapping::FactorKind::kFrameSwitch) switched_frames_.insert(f.a.index);
     next_factor_id_ = std::max(next_factor_id_, f.id + 1);
     LogAndSubmit(resume_candidate_->messages[k]);  // this log holds the whole graph again
@@ -697,6 +716,140 @@ void Mapd::TakeLoopMatches() {
   }
 }
 
+void Mapd::StartTags() {
+  if (!options_.tags || tags_) return;
+  std::string directory = options_.tag_tables_dir;
+  if (directory.empty() && !options_.output_stem.empty()) {
+    directory = std::filesystem::path(options_.output_stem).parent_path().string();
+  }
+  const mapping::TagObserverOptions tag_options = *options_.tags;
+  const calib::RectifiedIntrinsics camera = mapper_->rectified_intrinsics();
+  const cv::Size size = mapper_->rectified_size();
+  const bool build = options_.build_missing_tag_tables;
+  tags_ = std::make_unique<TagWorker>(
+      tag_options, camera, size, TagTableLoader([tag_options, camera, size, directory, build] {
+        return mapping::LoadTagErrorTables(
+            tag_options, camera, size, directory, build,
+            [](const std::string& line) { std::fprintf(stderr, "mapd: %s\n", line.c_str()); });
+      }),
+      options_.tag_nice_increment);
+  std::fprintf(stderr, "mapd: looking for %zu AprilTag markers (%s)\n", tag_options.markers.size(),
+               tag_options.detector.families[0].c_str());
+}
+
+void Mapd::TakeTagResults() {
+  if (const std::optional<std::string> error = tags_->TakeError()) {
+    std::fprintf(stderr, "mapd: %s\n", error->c_str());
+  }
+  for (TagResult& result : tags_->TakeResults()) {
+    newest_tag_stamp_ns_ = std::max(newest_tag_stamp_ns_, result.sighting.stamp_ns);
+    for (mapping::TagObservation& o : result.observations) {
+      HandleTagObservation(result.sighting, std::move(o));
+    }
+  }
+  ApplyTagDecisions(tag_resolver_.Expire(newest_tag_stamp_ns_));
+}
+
+void Mapd::HandleTagObservation(const TagSighting& sighting, mapping::TagObservation o) {
+  const bool landmark =
+      o.marker != nullptr && o.marker->carrier == mapping::TagMarker::Carrier::kLandmark;
+  const auto T_local_tag = [&](const Eigen::Isometry3d& T_cam_tag) {
+    return sighting.T_local_body * mapper_->T_body_cam() * T_cam_tag;
+  };
+  if (landmark && o.accepted) {
+    LogTag(sighting, o);
+    AddTagFactor(sighting, o);
+    // It votes for where the tag is, for the ambiguous sightings.
+    ApplyTagDecisions(tag_resolver_.Add({.key = 0,
+                                         .stamp_ns = sighting.stamp_ns,
+                                         .tag_id = o.detection.id,
+                                         .frame_id = sighting.frame_id,
+                                         .T_local_tag = {T_local_tag(o.pose->best.T_camera_tag)}}));
+    return;
+  }
+  if (landmark && o.uncertainty.ambiguous && o.pose && slam_) {
+    const uint64_t key = next_tag_key_++;
+    const mapping::TagPlacements placements{
+        .key = key,
+        .stamp_ns = sighting.stamp_ns,
+        .tag_id = o.detection.id,
+        .frame_id = sighting.frame_id,
+        .T_local_tag = {T_local_tag(o.pose->best.T_camera_tag),
+                        T_local_tag(o.pose->alternative.T_camera_tag)}};
+    waiting_tags_.emplace(key, std::pair{sighting, std::move(o)});
+    ApplyTagDecisions(tag_resolver_.Add(placements));
+    return;
+  }
+  if (o.accepted && o.marker != nullptr) ++stats_.robot_tags_seen;  // a d factor needs its graph
+  if (o.marker == nullptr && o.refusal.find("not in the configuration") != std::string::npos &&
+      unknown_tag_ids_.insert(o.detection.id).second) {
+    std::fprintf(stderr, "mapd: AprilTag id %d is not in the marker list: ignored\n",
+                 o.detection.id);
+  }
+  LogTag(sighting, o);
+}
+
+void Mapd::ApplyTagDecisions(const std::vector<mapping::TagDecision>& decisions) {
+  for (const mapping::TagDecision& d : decisions) {
+    const auto it = waiting_tags_.find(d.key);
+    if (it == waiting_tags_.end()) continue;
+    const TagSighting sighting = it->second.first;
+    mapping::TagObservation o = std::move(it->second.second);
+    waiting_tags_.erase(it);
+    if (d.solution >= 0) {
+      if (d.solution == 1) std::swap(o.pose->best, o.pose->alternative);
+      o.pose->tilt_rad = mapping::TagTilt(o.pose->best.T_camera_tag);
+      o.uncertainty = o.solutions[static_cast<std::size_t>(d.solution)];
+      o.accepted = o.uncertainty.accepted;
+      o.refusal = o.uncertainty.refusal;
+    } else {
+      o.refusal = d.refusal;
+    }
+    (o.accepted ? stats_.tags_resolved : stats_.tags_unresolved)++;
+    LogTag(sighting, o);
+    if (o.accepted) AddTagFactor(sighting, o);
+  }
+}
+
+void Mapd::LogTag(const TagSighting& sighting, const mapping::TagObservation& o) {
+  if (archive_) archive_->LogTagDetection(mapping::ToMsg(o, sighting.stamp_ns, "cam0"));
+  ++stats_.tag_observations_logged;
+}
+
+bool Mapd::FrameInGraph(uint32_t frame_id) const {
+  return (prior_frame_ && *prior_frame_ == frame_id) ||
+         (frame_id > 0 && switched_frames_.count(frame_id - 1) > 0);
+}
+
+void Mapd::AddTagFactor(const TagSighting& s, const mapping::TagObservation& o) {
+  if (!slam_) return;
+  if (!FrameInGraph(s.frame_id)) {
+    ++stats_.tag_sightings_unplaced;
+    return;
+  }
+  // One pose node per image, keyed by its capture time in ms: unique, and
+  // the same after a restart.
+  const int64_t pose = s.stamp_ns / 1'000'000;
+  if (tag_pose_nodes_.insert(pose).second) {
+    // The filter's covariance right after a frame switch is nearly zero; a
+    // floor (1 mm, 0.006 deg) keeps the factor's information finite.
+    mapping::Matrix6d covariance = s.covariance;
+    covariance.diagonal().head<3>().array() += 1e-6;
+    covariance.diagonal().tail<3>().array() += 1e-8;
+    mapping::GraphFactorRecord v =
+        mapping::FilterPoseFactor(options_.robot_id, s.frame_id, pose, s.T_local_body, covariance);
+    v.stamp_ns = s.stamp_ns;
+    AddFactor(std::move(v));
+    ++stats_.tag_sightings;
+  }
+  mapping::GraphFactorRecord factor = mapping::LandmarkObservationFactor(
+      options_.robot_id, pose, o.marker->landmark, mapper_->T_body_cam(), o.pose->best.T_camera_tag,
+      o.uncertainty.covariance, o.marker->T_carrier_tag);
+  factor.stamp_ns = s.stamp_ns;
+  AddFactor(std::move(factor));
+  ++stats_.tag_factors;
+}
+
 void Mapd::TakeSlamSnapshot() {
   for (const std::string& problem : slam_->TakeProblems()) {
     std::fprintf(stderr, "mapd: pose graph: %s\n", problem.c_str());
@@ -772,6 +925,12 @@ void Mapd::Shutdown() {
     loop_->Flush();
     TakeLoopMatches();
   }
+  if (tags_) {
+    tags_->Flush();
+    TakeTagResults();
+    tags_->Stop();
+    ApplyTagDecisions(tag_resolver_.Expire(newest_tag_stamp_ns_, true));
+  }
   if (slam_) {
     HandLatestPose();  // the run's final global pose is the last estimate's
     slam_->Flush();
@@ -809,6 +968,20 @@ void Mapd::Shutdown() {
     graph["match_data_spilled_bytes"] = std::to_string(l.store.spilled_bytes);
     graph["match_data_spill_reads"] = std::to_string(l.store.spill_reads);
   }
+  if (tags_) {
+    const TagWorkerStats t = tags_->Stats();
+    graph["tag_images"] = std::to_string(t.observer.images);
+    graph["tag_decoded"] = std::to_string(t.observer.decoded);
+    graph["tag_accepted"] = std::to_string(t.observer.accepted);
+    graph["tag_not_configured"] = std::to_string(t.observer.not_configured);
+    graph["tag_refused_by_detector"] = std::to_string(t.observer.refused_by_detector);
+    graph["tag_refused_by_model"] = std::to_string(t.observer.refused_by_model);
+    graph["tag_images_dropped"] = std::to_string(t.dropped + t.not_ready);
+    graph["tag_factors"] = std::to_string(stats_.tag_factors);
+    graph["tag_sightings"] = std::to_string(stats_.tag_sightings);
+    graph["tags_resolved"] = std::to_string(stats_.tags_resolved);
+    graph["tags_unresolved"] = std::to_string(stats_.tags_unresolved);
+  }
   std::map<std::string, std::string> statistics = {
       {"submaps", std::to_string(stats_.submaps_archived)},
       {"images_mapped", std::to_string(stats_.images_mapped)},
@@ -835,6 +1008,14 @@ void Mapd::PublishStatus() {
     m.missed = stats_.missed;
     m.requests = stats_.requests;
     m.submap_distance_m = trigger_.distance_m();
+    if (tags_) {
+      const TagWorkerStats t = tags_->Stats();
+      m.tags_accepted = t.observer.accepted;
+      m.tags_not_configured = t.observer.not_configured;
+      m.tags_refused =
+          t.observer.refused_by_detector + t.observer.refused_by_model + t.observer.no_pose;
+      m.tag_images_failed = t.failed;
+    }
   });
 }
 
@@ -895,6 +1076,31 @@ std::string Mapd::Summary() const {
                   static_cast<unsigned long long>(l.submaps), data_p50, match_p50, l.store.resident,
                   l.store.submaps, static_cast<double>(l.store.spilled_bytes) / 1e6,
                   static_cast<unsigned long long>(l.store.spill_reads));
+    out += text;
+  }
+  if (tags_) {
+    const TagWorkerStats t = tags_->Stats();
+    char text[520];
+    std::snprintf(text, sizeof(text),
+                  "  tags: %llu images searched (%llu dropped, %llu failed); %llu decoded: %llu "
+                  "accepted, %llu not in the marker list, %llu refused by the detector, %llu by "
+                  "the error model (of these ambiguous ones, %llu decided by the tag's other "
+                  "sightings, %llu not); %llu images -> %llu o factors (%llu tags before their "
+                  "frame was in the graph), %llu robot markers\n",
+                  static_cast<unsigned long long>(t.observer.images),
+                  static_cast<unsigned long long>(t.dropped + t.not_ready),
+                  static_cast<unsigned long long>(t.failed),
+                  static_cast<unsigned long long>(t.observer.decoded),
+                  static_cast<unsigned long long>(t.observer.accepted),
+                  static_cast<unsigned long long>(t.observer.not_configured),
+                  static_cast<unsigned long long>(t.observer.refused_by_detector),
+                  static_cast<unsigned long long>(t.observer.refused_by_model),
+                  static_cast<unsigned long long>(stats_.tags_resolved),
+                  static_cast<unsigned long long>(stats_.tags_unresolved),
+                  static_cast<unsigned long long>(stats_.tag_sightings),
+                  static_cast<unsigned long long>(stats_.tag_factors),
+                  static_cast<unsigned long long>(stats_.tag_sightings_unplaced),
+                  static_cast<unsigned long long>(stats_.robot_tags_seen));
     out += text;
   }
   if (first_memory_ && last_memory_) {

@@ -33,12 +33,14 @@
 #include "firmware/mapd/pose_history.h"
 #include "firmware/mapd/slam_worker.h"
 #include "firmware/mapd/submap_trigger.h"
+#include "firmware/mapd/tag_worker.h"
 #include "firmware/runtime/health/process_memory.h"
 #include "firmware/runtime/topics/rover_topics.h"
 #include "mapping/slam/frame_switch_noise.h"
 #include "mapping/slam/graph_log.h"
 #include "mapping/submap/submap.h"
 #include "mapping/submap/submap_options.h"
+#include "mapping/tags/tag_ambiguity_resolver.h"
 
 namespace rover::mapd {
 
@@ -88,6 +90,24 @@ struct MapdOptions {
   bool loop_closures = true;
   LoopCloserOptions loop{};
 
+  /// AprilTag detection on the mapped pairs' rectified left images (needs
+  /// mapping); nullopt: off. A sighting of landmark markers joins the graph
+  /// (with slam) as the filter's pose then (v) and one observation per tag
+  /// (o); robot markers are logged and counted.
+  std::optional<mapping::TagObserverOptions> tags{};
+  /// Where the tag error tables are (mapping::TagErrorTableFileName); empty:
+  /// beside mapd's log.
+  std::string tag_tables_dir{};
+  /// Build a missing or mismatched table there on the tag thread (seconds per
+  /// table) instead of switching detection off. For the simulator, whose
+  /// camera the tables cannot be made for ahead of time; a board has its
+  /// tables from rover-tags lut.
+  bool build_missing_tag_tables = false;
+  /// The tag thread runs this much nicer than mapd.
+  int tag_nice_increment = 5;
+  /// Deciding ambiguous detections by the tag's other sightings.
+  mapping::TagAmbiguityOptions tag_ambiguity{};
+
   /// Throws std::invalid_argument naming the key.
   void Validate() const;
 };
@@ -131,6 +151,14 @@ struct MapdStats {
   uint64_t graph_factors_refused = 0;   ///< malformed before reaching the graph (NaN, ...)
   uint64_t graph_factors_resumed = 0;   ///< taken over from the previous mapd's log
   uint64_t loop_closures = 0;           ///< accepted matches added to the graph
+  // AprilTags (the tag thread's own counts are in tag_stats()).
+  uint64_t tag_observations_logged = 0;
+  uint64_t tag_sightings = 0;           ///< pose nodes (v) of images with landmark tags
+  uint64_t tag_sightings_unplaced = 0;  ///< landmark tags whose frame was not in the graph
+  uint64_t tag_factors = 0;             ///< o factors added
+  uint64_t tags_resolved = 0;           ///< ambiguous, decided by the tag's other sightings
+  uint64_t tags_unresolved = 0;         ///< ambiguous, and refused in the end
+  uint64_t robot_tags_seen = 0;         ///< accepted robot markers (logged, no factor)
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
@@ -166,6 +194,8 @@ class Mapd {
   SlamStats slam_stats() const { return slam_ ? slam_->Stats() : SlamStats{}; }
   /// The loop closer's counters (empty without loop closures).
   LoopCloserStats loop_stats() const { return loop_ ? loop_->Stats() : LoopCloserStats{}; }
+  /// The tag thread's counters (empty with tags off).
+  TagWorkerStats tag_stats() const { return tags_ ? tags_->Stats() : TagWorkerStats{}; }
   /// The latest graph snapshot (update 0 without slam).
   SlamSnapshot slam_snapshot() const { return slam_ ? slam_->Latest() : SlamSnapshot{}; }
 
@@ -223,6 +253,22 @@ class Mapd {
   void LogGlobalPose(const SlamSnapshot& snap);
   /// Adds the loop closer's accepted matches to the graph.
   void TakeLoopMatches();
+  /// Starts the tag thread once the rectified camera is known.
+  void StartTags();
+  /// Logs the tag thread's observations and adds the landmark sightings'
+  /// factors.
+  void TakeTagResults();
+  /// Logs one observation, or keeps an ambiguous one until the resolver
+  /// decides it; accepted landmark tags join the graph.
+  void HandleTagObservation(const TagSighting& sighting, mapping::TagObservation observation);
+  /// Applies the resolver's decisions to the waiting observations.
+  void ApplyTagDecisions(const std::vector<mapping::TagDecision>& decisions);
+  void LogTag(const TagSighting& sighting, const mapping::TagObservation& observation);
+  /// The sighting's pose (v, once per image) and the tag's o factor.
+  void AddTagFactor(const TagSighting& sighting, const mapping::TagObservation& observation);
+  /// True if local frame `frame_id`'s origin is in the graph (the prior's
+  /// frame, or one a frame switch led to).
+  bool FrameInGraph(uint32_t frame_id) const;
   /// Logs what mapd's memory is made of (a "mapd: memory" status on
   /// /diagnostics), after a finished submap.
   void LogMemory(int64_t stamp_ns);
@@ -251,7 +297,16 @@ class Mapd {
   std::optional<Time> last_traversability_;
   std::unique_ptr<SlamWorker> slam_;
   std::unique_ptr<LoopCloser> loop_;
+  std::unique_ptr<TagWorker> tags_;
+  std::set<int> unknown_tag_ids_;  ///< reported once each
+  mapping::TagAmbiguityResolver tag_resolver_;
+  /// Ambiguous observations waiting for the resolver, by key.
+  std::map<uint64_t, std::pair<TagSighting, mapping::TagObservation>> waiting_tags_;
+  uint64_t next_tag_key_ = 1;
+  std::set<int64_t> tag_pose_nodes_;  ///< pose keys with their v factor
+  int64_t newest_tag_stamp_ns_ = 0;
   bool prior_added_ = false;
+  std::optional<int64_t> prior_frame_;
   uint64_t next_factor_id_ = 1;
   uint64_t last_snapshot_update_ = 0;
   uint64_t last_origins_update_ = 0;

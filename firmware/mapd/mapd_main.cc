@@ -18,6 +18,7 @@
 #include "firmware/mapd/mapd.h"
 #include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/health/systemd_notifier.h"
+#include "mapping/tags/tag_observer.h"
 
 namespace {
 
@@ -61,7 +62,8 @@ int main(int argc, char** argv) {
       "its origin. Maps the stereo pairs (SGBM depth, obstacle classification, 10 cm OctoMap\n"
       "and 5 cm cloud per submap) into OUT/mapd-<time>-<pid>.mcap. In threads below its own\n"
       "priority it matches finished submaps (4D: x, y, z, yaw) for loop closures and optimises\n"
-      "the pose graph (frame switches and matches), logging every factor as it is added; the\n"
+      "the pose graph (frame switches, matches and AprilTag landmark sightings), logging every\n"
+      "factor as it is added; the\n"
       "global map sits at the optimised origins. Stops on SIGTERM or SIGINT,\n"
       "then writes the global map beside the log (.bt, .ot for octovis; .ply) and prints its\n"
       "submaps.\n"};
@@ -95,6 +97,16 @@ int main(int argc, char** argv) {
   bool no_loop_closures = false;
   app.add_flag("--no-loop-closures", no_loop_closures,
                "match no submaps: the pose graph holds only the filter's frame switches");
+  std::string tags_file;
+  app.add_option("--tags", tags_file,
+                 "AprilTag marker file (YAML: families, sizes, which landmark or robot carries "
+                 "each id; see mapping/README.md); detections of landmarks join the pose graph. "
+                 "Default: the board's mapd.tags; none: no tag detection");
+  app.add_option("--tag-tables", options.tag_tables_dir,
+                 "folder of the tag error tables (rover-tags lut); default: the board's "
+                 "mapd.tag_tables, else beside mapd's log");
+  bool no_tags = false;
+  app.add_flag("--no-tags", no_tags, "no AprilTag detection, whatever the board says");
   bool match_6d = false;
   app.add_flag("--match-6d", match_6d,
                "match submaps with the 6D baseline (6D RANSAC and ICP) instead of the 4D "
@@ -118,6 +130,9 @@ int main(int argc, char** argv) {
       options.switch_noise.across_sigma_per_m = board.mapd.switch_across_sigma_per_m;
       options.switch_noise.yaw_sigma_rad_per_m = board.mapd.switch_yaw_sigma_rad_per_m;
       if (out_dir.empty()) out_dir = board.log.folder;
+      if (tags_file.empty()) tags_file = board.mapd.tags;
+      if (options.tag_tables_dir.empty()) options.tag_tables_dir = board.mapd.tag_tables;
+      options.build_missing_tag_tables = board.mapd.build_missing_tag_tables;
       if (app.get_option("--robot")->count() == 0) options.robot_name = board.board.name;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "mapd: %s\n", e.what());
@@ -125,6 +140,16 @@ int main(int argc, char** argv) {
     }
   }
   if (no_mapping) options.mapping = false;
+  if (!tags_file.empty() && !no_tags && options.mapping) {
+    try {
+      const rover::ConfigNode root = rover::ConfigNode::LoadFile(tags_file);
+      options.tags = rover::mapping::TagObserverOptions::Load(root);
+      root.CheckNoUnknownKeysRecursive();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "mapd: tag markers: %s\n", e.what());
+      return 78;  // EX_CONFIG
+    }
+  }
   if (no_loop_closures) options.loop_closures = false;
   if (match_6d) options.loop.matcher.mode = rover::mapping::MatchMode::kSixDof;
   if (!out_dir.empty() && options.mapping) {

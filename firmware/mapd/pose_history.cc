@@ -52,6 +52,9 @@ std::optional<StampedPose> PoseHistory::At(Time stamp) const {
   StampedPose out;
   out.stamp = stamp;
   out.frame_id = b.frame_id;
+  // Within a frame the filter's uncertainty only grows between estimates 2.5
+  // ms apart: the later one's bounds the interpolated pose's.
+  out.covariance = b.covariance;
   const Eigen::Quaterniond qa(a.T_local_body.linear());
   const Eigen::Quaterniond qb(b.T_local_body.linear());
   out.T_local_body.linear() = qa.slerp(t, qb).toRotationMatrix();

@@ -17,11 +17,13 @@
 
 namespace rover::mapd {
 
-/// An estimate: T_local_body in local frame `frame_id`.
+/// An estimate: T_local_body in local frame `frame_id`, with the filter's
+/// covariance of it (the graph's convention: [dp (local); dtheta (right)]).
 struct StampedPose {
   Time stamp;
   uint32_t frame_id = 0;
   Eigen::Isometry3d T_local_body = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 class PoseHistory {
@@ -34,7 +36,8 @@ class PoseHistory {
   bool Add(const StampedPose& pose);
 
   /// The pose at `stamp`, interpolated between the two estimates around it
-  /// (linear in position, slerp in rotation). Nullopt when `stamp` is older
+  /// (linear in position, slerp in rotation; the covariance is the larger
+  /// one's, the later estimate's). Nullopt when `stamp` is older
   /// than the history, newer than its newest estimate, or falls across a
   /// frame switch (the two estimates are in different frames).
   std::optional<StampedPose> At(Time stamp) const;

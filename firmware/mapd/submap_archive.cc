@@ -11,6 +11,7 @@
 #include "mapping/compose/submap_log.h"
 #include "mapping/slam/graph_log.h"
 #include "mapping/submap/submap_messages.h"
+#include "mapping/tags/tag_log.h"
 
 namespace rover::mapd {
 namespace {
@@ -102,6 +103,12 @@ void SubmapArchive::LogOrigins(const log::rover_msgs::SubmapOrigins& origins) {
   if (!log_) return;
   log_->Write(mapping::kSubmapOriginsTopic, log::FromRosTime(origins.header.stamp).nanoseconds(),
               origins);
+}
+
+void SubmapArchive::LogTagDetection(const log::rover_msgs::TagDetection& detection) {
+  if (!log_) return;
+  log_->Write(mapping::kTagDetectionTopic, log::FromRosTime(detection.header.stamp).nanoseconds(),
+              detection);
 }
 
 void SubmapArchive::LogDiagnostics(const log::diagnostic_msgs::DiagnosticArray& diagnostics) {

@@ -67,6 +67,8 @@ class SubmapArchive {
   void LogFactor(const log::rover_msgs::GraphFactor& factor);
   /// Logs the graph's origins after an update that changed them.
   void LogOrigins(const log::rover_msgs::SubmapOrigins& origins);
+  /// Logs one tag observation (mapping::kTagDetectionTopic).
+  void LogTagDetection(const log::rover_msgs::TagDetection& detection);
   /// Logs mapd's own diagnostics (its memory) on /diagnostics.
   void LogDiagnostics(const log::diagnostic_msgs::DiagnosticArray& diagnostics);
   /// Logs the global pose after an update.

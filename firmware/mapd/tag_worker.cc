@@ -9,7 +9,16 @@ namespace rover::mapd {
 TagWorker::TagWorker(const mapping::TagObserverOptions& options,
                      const calib::RectifiedIntrinsics& camera, cv::Size image_size,
                      const std::vector<mapping::TagErrorTable>& tables, int nice_increment)
-    : observer_(options, camera, image_size, tables),
+    : TagWorker(options, camera, image_size, TagTableLoader([tables] { return tables; }),
+                nice_increment) {}
+
+TagWorker::TagWorker(const mapping::TagObserverOptions& options,
+                     const calib::RectifiedIntrinsics& camera, cv::Size image_size,
+                     TagTableLoader load_tables, int nice_increment)
+    : options_(options),
+      camera_(camera),
+      image_size_(image_size),
+      load_tables_(std::move(load_tables)),
       nice_increment_(nice_increment),
       thread_([this] { Run(); }) {}
 
@@ -28,11 +37,39 @@ void TagWorker::Submit(const cv::Mat& rectified, const TagSighting& sighting) {
   {
     const std::lock_guard lock(mutex_);
     ++stats_.submitted;
+    if (failed_) {
+      ++stats_.not_ready;
+      return;
+    }
     if (pending_) ++stats_.dropped;
     rectified.copyTo(pending_image_);  // reuses the buffer once it has the size
     pending_ = sighting;
   }
   wake_.notify_all();
+}
+
+std::optional<std::string> TagWorker::TakeError() {
+  const std::lock_guard lock(mutex_);
+  std::optional<std::string> out;
+  out.swap(error_);
+  return out;
+}
+
+bool TagWorker::SetUp() {
+  std::string error;
+  try {
+    observer_ =
+        std::make_unique<mapping::TagObserver>(options_, camera_, image_size_, load_tables_());
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  const std::lock_guard lock(mutex_);
+  if (observer_) return true;
+  error_ = "AprilTag detection off: " + error;
+  failed_ = true;
+  if (pending_) ++stats_.not_ready;
+  pending_.reset();
+  return false;
 }
 
 std::vector<TagResult> TagWorker::TakeResults() {
@@ -55,6 +92,10 @@ void TagWorker::Flush() {
 void TagWorker::Run() {
   // Below mapd's main loop; detection reads no files.
   runtime::LowerCurrentThreadPriority(nice_increment_, runtime::IoPriorityClass::kUnchanged, 0);
+  if (!SetUp()) {
+    idle_.notify_all();
+    return;
+  }
   cv::Mat image;
   std::unique_lock lock(mutex_);
   while (true) {
@@ -68,11 +109,11 @@ void TagWorker::Run() {
     lock.unlock();
     bool failed = false;
     try {
-      result.observations = observer_.Observe(image);
+      result.observations = observer_->Observe(image);
     } catch (const std::exception&) {
       failed = true;  // an image of the wrong size: counted, the next one may do
     }
-    const mapping::TagObserverStats observer = observer_.stats();
+    const mapping::TagObserverStats observer = observer_->stats();
     lock.lock();
     busy_ = false;
     stats_.observer = observer;

@@ -11,7 +11,8 @@
 #include <Eigen/Geometry>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -41,9 +42,14 @@ struct TagWorkerStats {
   uint64_t submitted = 0;
   uint64_t dropped = 0;  ///< replaced while waiting: the thread was busy
   uint64_t processed = 0;
-  uint64_t failed = 0;  ///< the observer threw (bad image)
+  uint64_t failed = 0;     ///< the observer threw (bad image)
+  uint64_t not_ready = 0;  ///< handed over while detection is off (its set-up failed)
   mapping::TagObserverStats observer;
 };
+
+/// Reads (or builds) the error tables; runs on the tag thread, so that a
+/// slow build never holds up mapping. Throws to switch detection off.
+using TagTableLoader = std::function<std::vector<mapping::TagErrorTable>()>;
 
 class TagWorker {
  public:
@@ -51,12 +57,20 @@ class TagWorker {
   TagWorker(const mapping::TagObserverOptions& options, const calib::RectifiedIntrinsics& camera,
             cv::Size image_size, const std::vector<mapping::TagErrorTable>& tables,
             int nice_increment);
+  /// As above, with the tables from `load_tables`, called first on the
+  /// thread (images handed over meanwhile wait as usual). If it or the
+  /// observer's set-up throws, detection stays off, images are not kept
+  /// (counted as not_ready) and TakeError says why.
+  TagWorker(const mapping::TagObserverOptions& options, const calib::RectifiedIntrinsics& camera,
+            cv::Size image_size, TagTableLoader load_tables, int nice_increment);
   ~TagWorker();
   TagWorker(const TagWorker&) = delete;
   TagWorker& operator=(const TagWorker&) = delete;
 
   /// Hands over a rectified image (copied) and its sighting.
   void Submit(const cv::Mat& rectified, const TagSighting& sighting);
+  /// Why detection is off (once; nullopt while it is not).
+  std::optional<std::string> TakeError();
   /// Results finished since the last call, oldest first.
   std::vector<TagResult> TakeResults();
   TagWorkerStats Stats() const;
@@ -67,8 +81,14 @@ class TagWorker {
 
  private:
   void Run();
+  /// Builds the observer on the thread; false (and error_ set) if it fails.
+  bool SetUp();
 
-  mapping::TagObserver observer_;  // the worker thread's only
+  const mapping::TagObserverOptions options_;
+  const calib::RectifiedIntrinsics camera_;
+  const cv::Size image_size_;
+  TagTableLoader load_tables_;
+  std::unique_ptr<mapping::TagObserver> observer_;  // the worker thread's only
   const int nice_increment_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
@@ -77,6 +97,8 @@ class TagWorker {
   std::optional<TagSighting> pending_;
   bool busy_ = false;
   bool stop_ = false;
+  bool failed_ = false;  ///< the set-up failed: detection is off
+  std::optional<std::string> error_;
   std::vector<TagResult> done_;
   TagWorkerStats stats_;
   std::thread thread_;  // last: started once everything above exists

@@ -355,6 +355,10 @@ BoardConfig BoardConfig::Load(const ConfigNode& root) {
         mapd.Get<double>("switch_across_sigma_per_m", c.mapd.switch_across_sigma_per_m);
     c.mapd.switch_yaw_sigma_rad_per_m =
         mapd.Get<double>("switch_yaw_sigma_rad_per_m", c.mapd.switch_yaw_sigma_rad_per_m);
+    c.mapd.tags = mapd.Get<std::string>("tags", c.mapd.tags);
+    c.mapd.tag_tables = mapd.Get<std::string>("tag_tables", c.mapd.tag_tables);
+    c.mapd.build_missing_tag_tables =
+        mapd.Get<bool>("build_missing_tag_tables", c.mapd.build_missing_tag_tables);
   }
 
   if (Problem p = FindProblem(c)) FailAt(root, p->first, p->second);

@@ -22,7 +22,8 @@
 //   mapd: {submap_max_distance_m: 7.0, submap_max_position_sigma_m: 0.1,
 //          restart_backoff_s: 1.0, mapping: true, mapping_rate_hz: 2.0,
 //          switch_along_sigma_per_m: 0.0012, switch_across_sigma_per_m: 0.0006,
-//          switch_yaw_sigma_rad_per_m: 2.0e-4}
+//          switch_yaw_sigma_rad_per_m: 2.0e-4, tags: /etc/rover/tags.yaml,
+//          tag_tables: /etc/rover, build_missing_tag_tables: false}
 //
 // Every section except `board` and `log` is optional and every key in an
 // optional section defaults to the value shown. Unknown keys are errors.
@@ -155,6 +156,15 @@ struct BoardMapdOptions {
   double switch_along_sigma_per_m = 0.0012;
   double switch_across_sigma_per_m = 0.0006;
   double switch_yaw_sigma_rad_per_m = 2.0e-4;
+  /// The AprilTag marker file (mapping::TagObserverOptions: family, sizes,
+  /// which landmark or robot carries each id); empty: no tag detection.
+  /// Relative paths as the log folder's.
+  std::string tags{};
+  /// Where the tag error tables are (rover-tags lut); empty: beside mapd's log.
+  std::string tag_tables{};
+  /// Build a missing table on the tag thread instead of switching detection
+  /// off (the simulator; a board has its tables made ahead of time).
+  bool build_missing_tag_tables = false;
 };
 
 /// The whole board profile.

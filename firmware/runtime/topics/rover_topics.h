@@ -26,7 +26,7 @@
 namespace rover::runtime::topics {
 
 /// Bumped whenever a message below changes layout or meaning.
-inline constexpr uint32_t kTopicsVersion = 4;
+inline constexpr uint32_t kTopicsVersion = 5;
 
 inline constexpr std::string_view kPoseTopic = "/roverd/pose";
 inline constexpr std::string_view kStereoFrameTopic = "/roverd/stereo_frame";
@@ -132,6 +132,11 @@ struct MapdStatusMsg {
   uint64_t missed = 0;             ///< queue overflows noticed
   uint64_t requests = 0;           ///< frame switches requested
   double submap_distance_m = 0.0;  ///< driven in the current submap
+  /// AprilTags decoded and what became of them (all zero with tags off).
+  uint64_t tags_accepted = 0;        ///< into the graph (landmarks) or logged (robots)
+  uint64_t tags_not_configured = 0;  ///< an id the marker list does not have
+  uint64_t tags_refused = 0;         ///< by the detector's or the error model's checks, or no pose
+  uint64_t tag_images_failed = 0;    ///< images the detector could not take
 };
 
 /// roverd's health report: a diagnostic_msgs/DiagnosticArray as ROS 2 CDR

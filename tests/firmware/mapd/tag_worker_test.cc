@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
 #include "tests/mapping/tags/synthetic_tag_image.h"
 
 namespace rover::mapd {
@@ -23,7 +27,8 @@ mapping::TagObserverOptions OnePost() {
 }
 
 TEST(TagWorkerTest, ObservesSubmittedImagesAndKeepsTheirSighting) {
-  TagWorker worker(OnePost(), TestCamera(), cv::Size(752, 480), {}, 5);
+  TagWorker worker(OnePost(), TestCamera(), cv::Size(752, 480),
+                   std::vector<mapping::TagErrorTable>{}, 5);
   TagSighting sighting;
   sighting.stamp_ns = 42;
   sighting.frame_id = 2;
@@ -42,7 +47,8 @@ TEST(TagWorkerTest, ObservesSubmittedImagesAndKeepsTheirSighting) {
 }
 
 TEST(TagWorkerTest, AnImageOfTheWrongSizeIsCountedAndTheNextOneStillWorks) {
-  TagWorker worker(OnePost(), TestCamera(), cv::Size(752, 480), {}, 5);
+  TagWorker worker(OnePost(), TestCamera(), cv::Size(752, 480),
+                   std::vector<mapping::TagErrorTable>{}, 5);
   worker.Submit(cv::Mat(100, 100, CV_8UC1, cv::Scalar(0)), TagSighting{});
   worker.Flush();
   worker.Submit(RenderTag(3, 0.16, TagAt(1.2, 0.4), TestCamera()), TagSighting{});
@@ -56,11 +62,48 @@ TEST(TagWorkerTest, AnImageOfTheWrongSizeIsCountedAndTheNextOneStillWorks) {
 }
 
 TEST(TagWorkerTest, ABlankImageGivesNoResult) {
-  TagWorker worker(OnePost(), TestCamera(), cv::Size(752, 480), {}, 5);
+  TagWorker worker(OnePost(), TestCamera(), cv::Size(752, 480),
+                   std::vector<mapping::TagErrorTable>{}, 5);
   worker.Submit(cv::Mat(480, 752, CV_8UC1, cv::Scalar(90)), TagSighting{});
   worker.Flush();
   EXPECT_TRUE(worker.TakeResults().empty());
   EXPECT_EQ(worker.Stats().processed, 1u);
+}
+
+TEST(TagWorkerTest, TablesFailingToLoadSwitchDetectionOffWithTheReason) {
+  mapping::TagObserverOptions options = OnePost();
+  options.model.kind = mapping::TagErrorModelKind::kTable;
+  TagWorker worker(options, TestCamera(), cv::Size(752, 480),
+                   TagTableLoader([]() -> std::vector<mapping::TagErrorTable> {
+                     throw std::runtime_error("no table in /nowhere");
+                   }),
+                   5);
+  worker.Flush();  // returns once the set-up has failed
+  std::optional<std::string> error;
+  for (int k = 0; k < 200 && !error; ++k) {
+    error = worker.TakeError();
+    if (!error) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(error.has_value());
+  EXPECT_NE(error->find("no table in /nowhere"), std::string::npos) << *error;
+  EXPECT_FALSE(worker.TakeError().has_value()) << "said once";
+  worker.Submit(RenderTag(3, 0.16, TagAt(1.5, 0.5), TestCamera()), TagSighting{});
+  worker.Flush();
+  EXPECT_TRUE(worker.TakeResults().empty());
+  EXPECT_EQ(worker.Stats().not_ready, 1u);
+  EXPECT_EQ(worker.Stats().processed, 0u);
+}
+
+TEST(TagWorkerTest, ImagesHandedOverWhileTheTablesLoadAreObservedAfterwards) {
+  TagWorker worker(OnePost(), TestCamera(), cv::Size(752, 480), TagTableLoader([] {
+                     std::this_thread::sleep_for(std::chrono::milliseconds(100));
+                     return std::vector<mapping::TagErrorTable>{};
+                   }),
+                   5);
+  worker.Submit(RenderTag(3, 0.16, TagAt(1.5, 0.5), TestCamera()), TagSighting{});
+  worker.Flush();
+  EXPECT_EQ(worker.TakeResults().size(), 1u);
+  EXPECT_EQ(worker.Stats().not_ready, 0u);
 }
 
 }  // namespace
