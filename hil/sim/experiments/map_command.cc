@@ -29,6 +29,7 @@
 #include "mapping/graph/rover_graph.h"
 #include "mapping/slam/false_match_injection.h"
 #include "mapping/slam/graph_log.h"
+#include "mapping/tags/tag_log.h"
 
 namespace rover::sim::experiments {
 
@@ -266,9 +267,13 @@ void ReportFrameSwitchConsistency(const mapping::GraphLogContents& g,
 // frame: the newest origin) moved with that origin.
 Eigen::Vector3d ResolvedFinalPosition(const mapping::GraphLogContents& g,
                                       const std::vector<mapping::GraphFactorRecord>& extra,
-                                      double switch_sigma_scale = 1.0) {
+                                      double switch_sigma_scale = 1.0, bool without_tags = false) {
   mapping::RoverGraph graph;
   for (mapping::GraphFactorRecord f : g.factors) {
+    if (without_tags && (f.kind == mapping::FactorKind::kFilterPose ||
+                         f.kind == mapping::FactorKind::kLandmarkObservation)) {
+      continue;
+    }
     if (f.kind == mapping::FactorKind::kFrameSwitch) {
       f.covariance *= switch_sigma_scale * switch_sigma_scale;
     }
@@ -309,6 +314,26 @@ void ScoreFalseMatches(const mapping::GraphLogContents& g, const Eigen::Isometry
          << Num(r->resolved_error_pct, 4) << " %; with " << false_matches.size()
          << " false matches added (" << Num(100.0 * o.false_match_fraction, 0)
          << " % of all matches): " << Num(r->false_match_error_pct, 4) << " %\n";
+}
+
+// With tag sightings in the graph: the logged graph re-solved whole and
+// without them, scored as the logged final position.
+void ScoreTagSightings(const mapping::GraphLogContents& g, const Eigen::Isometry3d& T_world_graph,
+                       const Eigen::Vector3d& p_true, double distance_m, MapResult* r,
+                       std::ostream& report) {
+  uint64_t factors = 0;
+  for (const mapping::GraphFactorRecord& f : g.factors) {
+    factors += f.kind == mapping::FactorKind::kLandmarkObservation;
+  }
+  r->tag_factors = factors;
+  if (factors == 0 || distance_m <= 0.0) return;
+  const Eigen::Vector3d whole = T_world_graph * ResolvedFinalPosition(g, {});
+  const Eigen::Vector3d without = T_world_graph * ResolvedFinalPosition(g, {}, 1.0, true);
+  r->slam_resolved_error_pct = 100.0 * (whole - p_true).norm() / distance_m;
+  r->slam_without_tags_error_pct = 100.0 * (without - p_true).norm() / distance_m;
+  report << "  tag sightings: " << factors << " o factors; the logged graph re-solved: final "
+         << "error " << Num(r->slam_resolved_error_pct, 4) << " %, without the sightings "
+         << Num(r->slam_without_tags_error_pct, 4) << " %\n";
 }
 
 // Each optimised origin's error against its true origin, both taken relative
@@ -425,6 +450,7 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     r->slam_final_error_m = (p_est - p_true).norm();
     r->slam_final_error_pct = distance_m > 0.0 ? 100.0 * r->slam_final_error_m / distance_m
                                                : std::numeric_limits<double>::quiet_NaN();
+    ScoreTagSightings(g, *T_world_graph, p_true, distance_m, r, report);
     if ((options.false_match_fraction > 0.0 || options.switch_sigma_scale != 1.0) &&
         distance_m > 0.0) {
       ScoreFalseMatches(g, *T_world_graph, p_true, distance_m, options, r, report);
@@ -515,6 +541,20 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
     cameras.push_back(T_world_body * T_body_cam0);
   }
   r.quality = EvaluateMap(world, obstacles, rule, map, cloud, cameras, head.stereo, o.quality);
+  std::vector<log::rover_msgs::TagDetection> detections;
+  for (const std::string& path : o.mapd_logs) {
+    mapping::TagDetectionLog tags = mapping::ReadTagDetections(path);
+    for (const std::string& p : tags.problems) report << "    tags: " << p << "\n";
+    detections.insert(detections.end(), tags.detections.begin(), tags.detections.end());
+  }
+  r.tags = ScoreTagDetections(detections, world, [&](Time t) {
+    const sim::TrajectorySample s = trajectory.Evaluate((t - mission.start).ToSeconds());
+    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    T_world_body.linear() = s.q_world_body.toRotationMatrix();
+    T_world_body.translation() = s.p_world_body;
+    return T_world_body * T_body_cam0;
+  });
+  ReportTagScore(r.tags, report);
   if (!o.export_stem.empty()) {
     mapping::WriteOctreeBt(map, o.export_stem + ".bt");
     mapping::WritePly(cloud, o.export_stem + ".ply");
@@ -557,7 +597,11 @@ std::string MapResultFields(const MapResult& r) {
          " loop_closure_precision=" + Num(r.loop_closure_precision, 3) +
          " matcher_ms_p50=" + Num(r.matcher_ms_p50, 1) +
          " graph_update_ms_p99=" + Num(r.graph_update_ms_p99, 1) +
-         " frame_switch_nees=" + Num(r.frame_switch_nees, 2);
+         " frame_switch_nees=" + Num(r.frame_switch_nees, 2) +
+         " tag_detections=" + std::to_string(r.tags.accepted) +
+         " tag_factors=" + std::to_string(r.tag_factors) +
+         " tag_nees_in_bound_pct=" + Num(r.tags.nees_in_bound_pct, 1) +
+         " slam_without_tags_err_pct=" + Num(r.slam_without_tags_error_pct, 4);
 }
 
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err) {

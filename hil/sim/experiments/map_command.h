@@ -14,6 +14,7 @@
 
 #include "core/cli/subcommand.h"
 #include "hil/sim/experiments/map_evaluation.h"
+#include "hil/sim/experiments/tag_evaluation.h"
 
 namespace rover::sim::experiments {
 
@@ -78,6 +79,15 @@ struct MapResult {
   uint64_t false_matches = 0;
   double resolved_error_pct = std::numeric_limits<double>::quiet_NaN();
   double false_match_error_pct = std::numeric_limits<double>::quiet_NaN();
+  /// AprilTags: accepted detections logged, o factors in the graph, and the
+  /// accepted landmark detections' NEES against the truth (tag_evaluation.h).
+  TagScore tags;
+  uint64_t tag_factors = 0;
+  /// With o factors in the graph: the logged graph re-solved whole, and
+  /// without the tag sightings (v and o), final error % of distance: what
+  /// the tags did on the same run.
+  double slam_resolved_error_pct = std::numeric_limits<double>::quiet_NaN();
+  double slam_without_tags_error_pct = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Evaluates; throws std::runtime_error naming the file or the problem.
@@ -91,7 +101,8 @@ std::string MapResultFields(const MapResult& r);
 ///          obstacle_recall=... submaps=... submap_bytes_per_s=...
 ///          raw_stereo_bytes_per_s=... loop_closures=...
 ///          loop_closure_precision=... matcher_ms_p50=... graph_update_ms_p99=...
-///          frame_switch_nees=...
+///          frame_switch_nees=... tag_detections=... tag_factors=...
+///          tag_nees_in_bound_pct=... slam_without_tags_err_pct=...
 /// Errors go to `err`; returns kExitBadInput for unusable input.
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err);
 

@@ -28,6 +28,8 @@
 #include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/process/child_process.h"
 #include "hil/sim/experiments/map_command.h"
+#include "hil/sim/scenario/scenario.h"
+#include "hil/sim/world/world.h"
 
 namespace {
 
@@ -91,7 +93,8 @@ void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
               << " map_precision=nan map_recall=nan obstacle_precision=nan obstacle_recall=nan "
                  "submaps=0 submap_bytes_per_s=nan raw_stereo_bytes_per_s=nan loop_closures=0 "
                  "loop_closure_precision=nan matcher_ms_p50=nan graph_update_ms_p99=nan "
-                 "frame_switch_nees=nan\n";
+                 "frame_switch_nees=nan tag_detections=0 tag_factors=0 "
+                 "tag_nees_in_bound_pct=nan slam_without_tags_err_pct=nan\n";
   }
 }
 
@@ -116,6 +119,36 @@ std::optional<ChildProcess> StartRouDi(const std::string& config, const fs::path
   }
   Say("RouDi started (pid " + std::to_string(roudi.pid()) + ")");
   return roudi;
+}
+
+// The value given to roverd-sim for `option` ("--sim short" or
+// "--sim=short"), or `fallback`.
+std::string RoverdArg(const std::vector<std::string>& args, const std::string& option,
+                      const std::string& fallback) {
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    if (args[k] == option && k + 1 < args.size()) return args[k + 1];
+    if (args[k].rfind(option + "=", 0) == 0) return args[k].substr(option.size() + 1);
+  }
+  return fallback;
+}
+
+// Writes the mission world's tag markers for mapd (the site survey a real
+// mission would have) and returns the file's path.
+std::string WriteTagMarkers(const std::vector<std::string>& roverd_args, const fs::path& run_dir) {
+  namespace sim = rover::sim;
+  const std::string scenario_name = RoverdArg(roverd_args, "--sim", "short");
+  const uint64_t seed = std::stoull(RoverdArg(roverd_args, "--seed", "1"));
+  const sim::Scenario scenario = sim::LoadScenario(
+      sim::FindScenario(sim::DefaultScenarioDir(), scenario_name), sim::DefaultSimConfigDir());
+  const sim::World world = sim::World::Generate(scenario.world, seed);
+  const fs::path path = run_dir / "tags.yaml";
+  std::ofstream out(path);
+  out << sim::TagMarkerFile(world);
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+  std::size_t tags = 0;
+  for (const sim::TagCarrier& c : world.carriers) tags += c.tags.size();
+  Say("mapd looks for the world's " + std::to_string(tags) + " AprilTags (" + path.string() + ")");
+  return path.string();
 }
 
 ChildProcess StartMapd(const std::vector<std::string>& argv, const fs::path& run_dir) {
@@ -148,6 +181,10 @@ int main(int argc, char** argv) {
   app.add_option("--mapd", mapd, "mapd executable")->capture_default_str();
   app.add_option("--mapd-arg", mapd_args, "extra argument for mapd (repeatable)");
   app.add_flag("--no-mapd", no_mapd, "run roverd-sim with the link but without mapd");
+  bool no_tags = false;
+  app.add_flag("--no-tags", no_tags,
+               "mapd detects no AprilTags (by default it gets the simulated world's markers, "
+               "written to RUN_DIR/tags.yaml, and adds landmark sightings to its pose graph)");
   app.add_option("--roudi-config", roudi_config, "RouDi TOML config")->capture_default_str();
   app.add_option("--run-dir", run_dir, "pid files and RouDi's log")->capture_default_str();
   app.add_option("--restart-backoff-s", restart_backoff_s, "wait before restarting mapd")
@@ -181,6 +218,9 @@ int main(int argc, char** argv) {
       fs::remove(result_file);
       mapd_args.insert(mapd_args.end(), {"--out", evaluate_map});
       roverd_args.insert(roverd_args.end(), {"--result-file", result_file.string()});
+    }
+    if (!no_mapd && !no_tags) {
+      mapd_args.insert(mapd_args.end(), {"--tags", WriteTagMarkers(roverd_args, run_dir)});
     }
     std::vector<int> mapd_pids;
     std::optional<ChildProcess> roudi = StartRouDi(roudi_config, run_dir);

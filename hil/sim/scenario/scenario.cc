@@ -31,6 +31,17 @@ WorldOptions LoadWorldOptions(const ConfigNode& node) {
       o.crater_centers_xy_m.emplace_back(xy[i], xy[i + 1]);
     }
   }
+  if (node.Has("landmark_posts_xy_m")) {  // flat list: [x0, y0, x1, y1, ...]
+    const auto xy = node.Get<std::vector<double>>("landmark_posts_xy_m");
+    if (xy.size() % 2 != 0) node.Fail("landmark_posts_xy_m", "expected x, y pairs");
+    for (std::size_t i = 0; i + 1 < xy.size(); i += 2) {
+      o.landmark_posts_xy_m.emplace_back(xy[i], xy[i + 1]);
+    }
+    if (static_cast<int>(o.landmark_posts_xy_m.size()) > o.landmark_post_count) {
+      node.Fail("landmark_posts_xy_m", "more posts placed than landmark_post_count (" +
+                                           std::to_string(o.landmark_post_count) + ")");
+    }
+  }
   return o;
 }
 

@@ -240,4 +240,33 @@ void ExportWorldGroundTruth(const World& world, const std::string& dir,
   }
 }
 
+std::string TagMarkerFile(const World& world) {
+  std::ostringstream out;
+  out << "# The simulated world's AprilTags (seed " << world.seed
+      << "): landmark posts and other rovers.\n"
+      << "families: [tag36h11]\nmarkers:\n";
+  int64_t landmark = 0;
+  int robot = 1;
+  for (const TagCarrier& carrier : world.carriers) {
+    for (const TagMarker& tag : carrier.tags) {
+      out << "  - {id: " << tag.id << ", size_m: " << Num(tag.size_m) << ", ";
+      if (carrier.is_static) {
+        out << "landmark: " << landmark;
+      } else {
+        out << "robot: " << robot;
+      }
+      out << ", T_carrier_tag: [";
+      const Eigen::Matrix4d T = tag.T_carrier_tag.matrix();
+      for (int i = 0; i < 16; ++i) out << (i > 0 ? ", " : "") << Num(T(i / 4, i % 4));
+      out << "]}  # " << carrier.name << "\n";
+    }
+    if (carrier.is_static) {
+      ++landmark;
+    } else {
+      ++robot;
+    }
+  }
+  return out.str();
+}
+
 }  // namespace rover::sim

@@ -136,6 +136,11 @@ std::vector<PostSite> PlacePosts(const WorldOptions& options, double half_m,
   const double r_max = std::min(40.0, half_m - 2.0);
   const double r_min = std::min(5.0, 0.5 * r_max);
   for (int k = 0; k < options.landmark_post_count; ++k) {
+    if (static_cast<std::size_t>(k) < options.landmark_posts_xy_m.size()) {
+      posts.push_back(
+          {options.landmark_posts_xy_m[static_cast<std::size_t>(k)], RandomUnitVector(rng)});
+      continue;
+    }
     for (int attempt = 0; attempt < 1000; ++attempt) {
       const Eigen::Vector2d direction = RandomUnitVector(rng);
       // Uniform over the annulus's area.

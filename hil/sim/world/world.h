@@ -193,6 +193,10 @@ struct WorldOptions {
   /// Centres of the first craters, overriding their random placement (a
   /// scenario puts its crater beside its route).
   std::vector<Eigen::Vector2d> crater_centers_xy_m;
+  /// Feet of the first landmark posts, overriding their random placement (a
+  /// scenario puts its posts beside its route, to be seen and seen again);
+  /// their headings stay random. At most landmark_post_count.
+  std::vector<Eigen::Vector2d> landmark_posts_xy_m;
   /// Polylines the rovers drive along: no rock or post within
   /// clear_path_half_width_m of them, so routes never cross an obstacle.
   std::vector<std::vector<Eigen::Vector2d>> clear_paths_xy_m;
@@ -300,6 +304,13 @@ std::string DescribeObstacleRule(const ObstacleRuleOptions& rule);
 /// same seed exports identical files. Throws std::runtime_error if a file cannot be written.
 void ExportWorldGroundTruth(const World& world, const std::string& dir,
                             const ObstacleRuleOptions& rule = {});
+
+/// mapd's marker file (mapping::TagObserverOptions::Load) for the world's
+/// tags, as a site survey would give it: family tag36h11; every tag of
+/// landmark post k is a marker of landmark k with its T_carrier_tag (so the
+/// four faces are one landmark); the tags of moving carriers are robot
+/// markers (robot 1, 2, ... in carrier order).
+std::string TagMarkerFile(const World& world);
 
 }  // namespace rover::sim
 

@@ -30,8 +30,9 @@ TEST(ScenarioTest, TheShippedScenariosLoad) {
     EXPECT_EQ(s.name, fs::path(f).stem().string()) << "name must match the file name";
     names.push_back(s.name);
   }
-  EXPECT_THAT(names, ::testing::IsSupersetOf({"short", "loop-100m", "mixed-300m", "two-rovers",
-                                              "figure-eight-1km", "monotonous-200m"}));
+  EXPECT_THAT(names,
+              ::testing::IsSupersetOf({"short", "loop-100m", "mixed-300m", "two-rovers",
+                                       "figure-eight-1km", "monotonous-200m", "landmarks-200m"}));
 }
 
 TEST(ScenarioTest, RouteLengthsAndDurationsMatchTheirNames) {
@@ -46,6 +47,40 @@ TEST(ScenarioTest, RouteLengthsAndDurationsMatchTheirNames) {
   EXPECT_NEAR(eight.distance_m(), 1000.0, 30.0);
   const RoverTrajectory lanes(Load("monotonous-200m").route, flat);
   EXPECT_NEAR(lanes.distance_m(), 200.0, 10.0);
+}
+
+TEST(ScenarioTest, TheLandmarkLanesSeeTheirPostsAgainAfterAHundredMetres) {
+  const Scenario s = Load("landmarks-200m");
+  ASSERT_EQ(s.world.landmark_posts_xy_m.size(), 5u);
+  EXPECT_EQ(s.world.landmark_post_count, 5);
+  const RoverTrajectory lanes(s.route, Flat());
+  // Each post stands beside the lanes, never on them, and at least one is
+  // passed again (within 6 m, ahead) after 100 m or more of driving.
+  double longest_gap_m = 0.0;
+  for (const Eigen::Vector2d& post : s.world.landmark_posts_xy_m) {
+    double nearest_m = 1e9;
+    double first_m = -1.0;
+    double last_m = -1.0;
+    double driven_m = 0.0;
+    Eigen::Vector2d previous = lanes.Evaluate(0.0).p_world_body.head<2>();
+    for (double t = 0.0; t <= lanes.duration_s(); t += 0.5) {
+      const TrajectorySample x = lanes.Evaluate(t);
+      const Eigen::Vector2d p = x.p_world_body.head<2>();
+      driven_m += (p - previous).norm();
+      previous = p;
+      const Eigen::Vector2d to_post = post - p;
+      nearest_m = std::min(nearest_m, to_post.norm());
+      const Eigen::Vector2d forward = (x.q_world_body * Eigen::Vector3d::UnitX()).head<2>();
+      if (to_post.norm() < 6.0 && to_post.dot(forward) > 0.0) {
+        if (first_m < 0.0) first_m = driven_m;
+        last_m = driven_m;
+      }
+    }
+    EXPECT_GT(nearest_m, 1.5) << "post at " << post.transpose() << " on the route";
+    EXPECT_LT(nearest_m, 2.5) << "post at " << post.transpose() << " out of sight";
+    longest_gap_m = std::max(longest_gap_m, last_m - first_m);
+  }
+  EXPECT_GE(longest_gap_m, 100.0);
 }
 
 TEST(ScenarioTest, TheFigureEightRevisitsItsGroundFromTheOppositeDirection) {

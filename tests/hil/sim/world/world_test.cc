@@ -15,7 +15,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/config/config.h"
 #include "hil/sim/world/world.h"
+#include "mapping/tags/tag_observer.h"
 #include "tests/hil/sim/world/test_worlds.h"
 
 namespace rover::sim {
@@ -481,6 +483,57 @@ TEST(WorldTest, AlbedoGivesCornersFromOneToTwentyMetres) {
   EXPECT_GE(near, 30);
   EXPECT_GE(middle, 30);
   EXPECT_GE(far, 10);
+}
+
+TEST(WorldTest, PlacedPostsStandWhereTheScenarioSaysAndTheRestAreRandom) {
+  WorldOptions options = SmallWorldOptions();
+  options.landmark_post_count = 3;
+  options.landmark_posts_xy_m = {Eigen::Vector2d(6.0, -2.0), Eigen::Vector2d(-4.0, 5.0)};
+  const World world = World::Generate(options, 7);
+  ASSERT_GE(world.carriers.size(), 3u);
+  EXPECT_TRUE(world.carriers[0].T_world_carrier.translation().head<2>().isApprox(
+      Eigen::Vector2d(6.0, -2.0)));
+  EXPECT_TRUE(world.carriers[1].T_world_carrier.translation().head<2>().isApprox(
+      Eigen::Vector2d(-4.0, 5.0)));
+  EXPECT_NEAR(world.carriers[0].T_world_carrier.translation().z(),
+              world.terrain.HeightAt(6.0, -2.0), 1e-9);
+  EXPECT_TRUE(world.carriers[2].is_static);
+  EXPECT_FALSE(world.carriers[2].T_world_carrier.translation().head<2>().isApprox(
+      Eigen::Vector2d(6.0, -2.0)));
+}
+
+TEST(WorldTest, TheTagMarkerFileNamesEveryTagWithItsCarrier) {
+  const World& world = SmallWorld();
+  const std::string file = TagMarkerFile(world);
+  std::size_t posts = 0;
+  std::size_t tags = 0;
+  for (const TagCarrier& c : world.carriers) {
+    posts += c.is_static;
+    tags += c.tags.size();
+  }
+  ASSERT_GT(posts, 0u);
+  // One line per tag, each with its carrier's name.
+  std::size_t lines = 0;
+  for (std::size_t at = file.find("  - {id: "); at != std::string::npos;
+       at = file.find("  - {id: ", at + 1)) {
+    ++lines;
+  }
+  EXPECT_EQ(lines, tags);
+  EXPECT_NE(file.find("landmark: 0, T_carrier_tag: ["), std::string::npos) << file;
+  EXPECT_NE(file.find("robot: 1, T_carrier_tag: ["), std::string::npos) << file;
+  EXPECT_NE(file.find("families: [tag36h11]"), std::string::npos);
+  // mapd reads it: the first post's second tag, with its pose on the post.
+  const mapping::TagObserverOptions options =
+      mapping::TagObserverOptions::Load(ConfigNode::LoadString(file, "tags.yaml"));
+  ASSERT_EQ(options.markers.size(), tags);
+  const TagMarker& tag = world.carriers[0].tags[1];
+  const mapping::TagMarker& marker = options.markers[1];
+  EXPECT_EQ(marker.id, tag.id);
+  EXPECT_DOUBLE_EQ(marker.size_m, tag.size_m);
+  EXPECT_EQ(marker.carrier, mapping::TagMarker::Carrier::kLandmark);
+  EXPECT_EQ(marker.landmark, 0);
+  EXPECT_TRUE(marker.T_carrier_tag.isApprox(tag.T_carrier_tag, 1e-12));
+  EXPECT_EQ(options.markers.back().carrier, mapping::TagMarker::Carrier::kRobot);
 }
 
 }  // namespace
