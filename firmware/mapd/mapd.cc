@@ -802,10 +802,20 @@ void Mapd::ApplyTagDecisions(const std::vector<mapping::TagDecision>& decisions)
       o.uncertainty = o.solutions[static_cast<std::size_t>(d.solution)];
       o.accepted = o.uncertainty.accepted;
       o.refusal = o.uncertainty.refusal;
+    } else if (d.undecided && o.inflated.accepted) {
+      // Nothing decided: kept with its rotation left open (both solutions
+      // covered), for the position that both share.
+      o.uncertainty = o.inflated;
+      o.accepted = true;
+      o.refusal.clear();
     } else {
       o.refusal = d.refusal;
     }
-    (o.accepted ? stats_.tags_resolved : stats_.tags_unresolved)++;
+    if (d.solution >= 0) {
+      ++stats_.tags_resolved;
+    } else {
+      (o.accepted ? stats_.tags_inflated : stats_.tags_unresolved)++;
+    }
     LogTag(sighting, o);
     if (o.accepted) AddTagFactor(sighting, o);
   }
@@ -980,6 +990,7 @@ void Mapd::Shutdown() {
     graph["tag_factors"] = std::to_string(stats_.tag_factors);
     graph["tag_sightings"] = std::to_string(stats_.tag_sightings);
     graph["tags_resolved"] = std::to_string(stats_.tags_resolved);
+    graph["tags_inflated"] = std::to_string(stats_.tags_inflated);
     graph["tags_unresolved"] = std::to_string(stats_.tags_unresolved);
   }
   std::map<std::string, std::string> statistics = {
@@ -1085,7 +1096,8 @@ std::string Mapd::Summary() const {
                   "  tags: %llu images searched (%llu dropped, %llu failed); %llu decoded: %llu "
                   "accepted, %llu not in the marker list, %llu refused by the detector, %llu by "
                   "the error model (of these ambiguous ones, %llu decided by the tag's other "
-                  "sightings, %llu not); %llu images -> %llu o factors (%llu tags before their "
+                  "sightings, %llu kept with their rotation left open, %llu refused); %llu images "
+                  "-> %llu o factors (%llu tags before their "
                   "frame was in the graph), %llu robot markers\n",
                   static_cast<unsigned long long>(t.observer.images),
                   static_cast<unsigned long long>(t.dropped + t.not_ready),
@@ -1096,6 +1108,7 @@ std::string Mapd::Summary() const {
                   static_cast<unsigned long long>(t.observer.refused_by_detector),
                   static_cast<unsigned long long>(t.observer.refused_by_model),
                   static_cast<unsigned long long>(stats_.tags_resolved),
+                  static_cast<unsigned long long>(stats_.tags_inflated),
                   static_cast<unsigned long long>(stats_.tags_unresolved),
                   static_cast<unsigned long long>(stats_.tag_sightings),
                   static_cast<unsigned long long>(stats_.tag_factors),

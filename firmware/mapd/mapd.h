@@ -157,7 +157,8 @@ struct MapdStats {
   uint64_t tag_sightings_unplaced = 0;  ///< landmark tags whose frame was not in the graph
   uint64_t tag_factors = 0;             ///< o factors added
   uint64_t tags_resolved = 0;           ///< ambiguous, decided by the tag's other sightings
-  uint64_t tags_unresolved = 0;         ///< ambiguous, and refused in the end
+  uint64_t tags_inflated = 0;           ///< ambiguous, undecided: kept with the rotation left open
+  uint64_t tags_unresolved = 0;         ///< ambiguous, and refused in the end (fit neither)
   uint64_t robot_tags_seen = 0;         ///< accepted robot markers (logged, no factor)
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.

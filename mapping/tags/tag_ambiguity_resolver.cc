@@ -11,9 +11,10 @@ void Require(bool ok, const std::string& key, const std::string& expected) {
   if (!ok) throw std::invalid_argument("TagAmbiguityOptions." + key + ": expected " + expected);
 }
 
-TagDecision Refused(const TagPlacements& s, std::string why) {
+TagDecision Undecided(const TagPlacements& s, std::string why) {
   TagDecision d;
   d.key = s.key;
+  d.undecided = true;
   d.refusal = std::move(why);
   return d;
 }
@@ -62,9 +63,9 @@ std::vector<TagDecision> TagAmbiguityResolver::Add(const TagPlacements& sighting
     }
     for (std::size_t k = 0; k < it->second.sightings.size(); ++k) {
       if (it->second.waiting[k]) {
-        out.push_back(Refused(it->second.sightings[k],
-                              "ambiguous, and its local frame ended before enough sightings "
-                              "agreed"));
+        out.push_back(Undecided(it->second.sightings[k],
+                                "ambiguous, and its local frame ended before enough sightings "
+                                "agreed"));
       }
     }
     it = groups_.erase(it);
@@ -72,7 +73,7 @@ std::vector<TagDecision> TagAmbiguityResolver::Add(const TagPlacements& sighting
   Group& g = groups_[{sighting.frame_id, sighting.tag_id}];
   if (static_cast<int>(g.sightings.size()) >= options_.max_sightings) {
     if (g.waiting.front()) {
-      out.push_back(Refused(g.sightings.front(), "ambiguous, and still undecided"));
+      out.push_back(Undecided(g.sightings.front(), "ambiguous, and still undecided"));
     }
     g.sightings.erase(g.sightings.begin());
     g.waiting.erase(g.waiting.begin());
@@ -140,8 +141,10 @@ std::vector<TagDecision> TagAmbiguityResolver::Expire(int64_t now_ns, bool all) 
     for (std::size_t k = 0; k < g.sightings.size(); ++k) {
       if (g.waiting[k] && (all || now_ns - g.sightings[k].stamp_ns > max_wait_ns)) {
         g.waiting[k] = false;
-        out.push_back(Refused(g.sightings[k], "ambiguous, and still undecided after " +
-                                                  std::to_string(options_.max_wait_s) + " s"));
+        out.push_back(Undecided(
+            g.sightings[k],
+            all ? "ambiguous, and undecided when the sightings ended"
+                : "ambiguous, and undecided after " + std::to_string(options_.max_wait_s) + " s"));
       }
     }
   }

@@ -54,8 +54,12 @@ struct TagPlacements {
 
 struct TagDecision {
   uint64_t key = 0;
-  int solution = -1;    ///< 0 best, 1 alternative; -1 refused
-  std::string refusal;  ///< why, when refused
+  int solution = -1;  ///< 0 best, 1 alternative; -1 neither
+  /// With solution -1: true if the sightings could not decide (too few, or a
+  /// rival placement too close: the caller may keep the detection with its
+  /// rotation left open), false if they decided against both solutions.
+  bool undecided = false;
+  std::string refusal;  ///< why no solution was chosen
   int support = 0;      ///< sightings that agreed with the chosen placement
 };
 

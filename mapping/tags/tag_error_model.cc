@@ -106,6 +106,16 @@ TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& cor
   return u;
 }
 
+TagUncertainty TagErrorModel::Inflated(const TagPose& pose, const TagUncertainty& best) {
+  TagUncertainty u = best;
+  if (!u.accepted) return u;
+  const TagPoseErrors d = TagPoseError(pose.best.T_camera_tag, pose.alternative.T_camera_tag);
+  u.covariance += d * d.transpose();
+  u.sigma = u.covariance.diagonal().cwiseSqrt();
+  u.ambiguous = true;
+  return u;
+}
+
 TagUncertainty TagErrorModel::ForSolution(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
                                           const calib::RectifiedIntrinsics& camera) const {
   TagUncertainty u;

@@ -92,6 +92,14 @@ class TagErrorModel {
   TagUncertainty ForSolution(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
                              const calib::RectifiedIntrinsics& camera) const;
 
+  /// The thesis's other way with an unstable pose, for an ambiguous
+  /// detection nothing decides: inflated so that it claims neither
+  /// solution's rotation. `best` (ForSolution of pose.best) plus the outer
+  /// product of the difference between the two solutions: the alternative
+  /// lies one sigma away along it, while the position, which both solutions
+  /// share to millimetres, keeps nearly its own sigma.
+  static TagUncertainty Inflated(const TagPose& pose, const TagUncertainty& best);
+
   const TagErrorModelOptions& options() const { return options_; }
 
  private:

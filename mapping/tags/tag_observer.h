@@ -71,8 +71,10 @@ struct TagObservation {
   std::string refusal;  ///< why not, when not accepted
   /// Ambiguous detections only (uncertainty.ambiguous): the covariance of
   /// each solution (best, alternative), should the tag's other sightings
-  /// decide between them.
+  /// decide between them, and of the best inflated to cover both
+  /// (TagErrorModel::Inflated), should nothing decide.
   std::array<TagUncertainty, 2> solutions{};
+  TagUncertainty inflated;
 };
 
 struct TagObserverStats {

@@ -601,6 +601,7 @@ std::string MapResultFields(const MapResult& r) {
          " tag_detections=" + std::to_string(r.tags.accepted) +
          " tag_factors=" + std::to_string(r.tag_factors) +
          " tag_nees_in_bound_pct=" + Num(r.tags.nees_in_bound_pct, 1) +
+         " tag_flips_claimed=" + std::to_string(r.tags.wrong_solutions_claimed) +
          " slam_without_tags_err_pct=" + Num(r.slam_without_tags_error_pct, 4);
 }
 

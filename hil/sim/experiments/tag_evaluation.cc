@@ -55,7 +55,9 @@ TagScore ScoreTagDetections(const std::vector<log::rover_msgs::TagDetection>& de
     s.nees_in_bound += x <= kChi2Six95;
     position_pct.push_back(100.0 * e.head<3>().norm() / distance_m);
     rotation_deg.push_back(e.tail<3>().norm() / kDeg);
-    s.wrong_solutions += e.tail<3>().norm() > 20.0 * kDeg;
+    const bool wrong = e.tail<3>().norm() > 20.0 * kDeg;
+    s.wrong_solutions += wrong;
+    s.wrong_solutions_claimed += wrong && x > kChi2Six95;
     s.normalized_rms += e.cwiseQuotient(covariance.diagonal().cwiseSqrt()).cwiseAbs2();
     s.mean_position_error_m += e.head<3>();
   }
@@ -79,13 +81,15 @@ void ReportTagScore(const TagScore& s, std::ostream& report) {
                 "  tags vs truth: %llu observations logged, %llu accepted, %llu on landmarks "
                 "scored: NEES within the chi^2(6) 95 %% bound for %.1f %% (median %.2f, mean "
                 "%.2f; 6 if consistent), error median %.2f %% of the distance and %.2f deg, %llu "
-                "wrong solutions; error over sigma (RMS) x %.2f y %.2f z %.2f, roll %.2f pitch "
+                "wrong solutions (%llu not covered by their covariance); error over sigma (RMS) x "
+                "%.2f y %.2f z %.2f, roll %.2f pitch "
                 "%.2f yaw %.2f; mean position error %+.1f %+.1f %+.1f mm (camera)\n",
                 static_cast<unsigned long long>(s.decoded),
                 static_cast<unsigned long long>(s.accepted),
                 static_cast<unsigned long long>(s.scored), s.nees_in_bound_pct, s.nees_median,
                 s.nees_mean, s.position_error_pct_median, s.rotation_error_deg_median,
-                static_cast<unsigned long long>(s.wrong_solutions), s.normalized_rms(0),
+                static_cast<unsigned long long>(s.wrong_solutions),
+                static_cast<unsigned long long>(s.wrong_solutions_claimed), s.normalized_rms(0),
                 s.normalized_rms(1), s.normalized_rms(2), s.normalized_rms(3), s.normalized_rms(4),
                 s.normalized_rms(5), 1e3 * s.mean_position_error_m.x(),
                 1e3 * s.mean_position_error_m.y(), 1e3 * s.mean_position_error_m.z());

@@ -33,8 +33,10 @@ struct TagScore {
   double position_error_pct_median = std::numeric_limits<double>::quiet_NaN();
   double rotation_error_deg_median = std::numeric_limits<double>::quiet_NaN();
   /// Accepted poses more than 20 deg off: the wrong solution of the planar
-  /// ambiguity.
+  /// ambiguity; and of those, the ones whose covariance does not cover the
+  /// error (NEES beyond the bound): a wrong rotation claimed.
   uint64_t wrong_solutions = 0;
+  uint64_t wrong_solutions_claimed = 0;
   /// RMS of each error over its stated sigma (dx dy dz [camera], droll
   /// dpitch dyaw [tag]): 1 where the covariance is right for that axis.
   Eigen::Matrix<double, 6, 1> normalized_rms = Eigen::Matrix<double, 6, 1>::Zero();

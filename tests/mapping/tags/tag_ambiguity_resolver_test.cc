@@ -69,6 +69,7 @@ TEST(TagAmbiguityResolverTest, TwoStillSolutionsAreNeverDecided) {
   ASSERT_EQ(expired.size(), 10u);
   for (const TagDecision& d : expired) {
     EXPECT_EQ(d.solution, -1);
+    EXPECT_TRUE(d.undecided);
     EXPECT_NE(d.refusal.find("undecided"), std::string::npos) << d.refusal;
   }
 }
@@ -92,6 +93,7 @@ TEST(TagAmbiguityResolverTest, AcceptedSightingsVoteAndMisfitsAreRefused) {
   ASSERT_EQ(d.size(), 1u);
   EXPECT_EQ(d[0].key, 4u);
   EXPECT_EQ(d[0].solution, -1);
+  EXPECT_FALSE(d[0].undecided) << "decided against both";
   EXPECT_NE(d[0].refusal.find("neither"), std::string::npos) << d[0].refusal;
   // Another tag, or the same tag in another frame, is another matter.
   EXPECT_TRUE(resolver.Add(Ambiguous(5, TrueTag(), Wrong(50.0 * kDeg), 5)).empty());

@@ -116,6 +116,29 @@ TEST(TagErrorModelTest, ALineOfSightFrameIsARotationAlongTheLineOfSight) {
   EXPECT_TRUE(LineOfSightRotation(Eigen::Vector3d(0, 0, 1)).isApprox(Eigen::Matrix3d::Identity()));
 }
 
+TEST(TagErrorModelTest, AnInflatedUncertaintyCoversBothSolutions) {
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const TagErrorModel model(TagErrorModelOptions{}, Table());
+  // Small and far, nearly head-on: the two solutions are far apart in
+  // rotation and close in position.
+  const auto corners = ProjectTagCorners(TagAt(4.5, 0.2, 0.1), kTagSizeM, camera);
+  std::string error;
+  const auto pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
+  ASSERT_TRUE(pose.has_value()) << error;
+  const TagUncertainty best = model.ForSolution(pose->best.T_camera_tag, kTagSizeM, camera);
+  ASSERT_TRUE(best.accepted);
+  const TagUncertainty inflated = TagErrorModel::Inflated(*pose, best);
+  ASSERT_TRUE(inflated.accepted);
+  EXPECT_TRUE(inflated.ambiguous);
+  const TagPoseErrors d = TagPoseError(pose->best.T_camera_tag, pose->alternative.T_camera_tag);
+  ASSERT_GT(d.tail<3>().norm(), 0.1) << "the two solutions should differ";
+  // The alternative lies within one sigma along the difference ...
+  EXPECT_LE(d.dot(inflated.covariance.ldlt().solve(d)), 1.0);
+  EXPECT_GT(d.dot(best.covariance.ldlt().solve(d)), 12.6) << "not covered before";
+  // ... and the position keeps its sigma across the line of sight.
+  EXPECT_LT(inflated.sigma(0), 3.0 * best.covariance(0, 0) / std::sqrt(best.covariance(0, 0)));
+}
+
 TEST(TagErrorModelTest, AnUnstablePoseIsRefusedAsAmbiguous) {
   const calib::RectifiedIntrinsics camera = TestCamera();
   const TagErrorModel model(TagErrorModelOptions{}, Table());
