@@ -203,6 +203,7 @@ std::vector<TagObservation> TagObserver::Observe(const cv::Mat& rectified) {
       o.solutions = {
           model.ForSolution(o.pose->best.T_camera_tag, o.marker->size_m, camera_),
           model.ForSolution(o.pose->alternative.T_camera_tag, o.marker->size_m, camera_)};
+      o.inflated = TagErrorModel::Inflated(*o.pose, o.solutions[0]);
     }
     o.accepted = o.uncertainty.accepted;
     o.refusal = o.uncertainty.refusal;

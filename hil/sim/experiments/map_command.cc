@@ -4,9 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -262,13 +264,12 @@ void ReportFrameSwitchConsistency(const mapping::GraphLogContents& g,
          << "; mean NEES " << Num(r->frame_switch_nees, 2) << " (consistent: 4)\n";
 }
 
-// The final global pose after re-solving the logged graph, with `extra`
-// factors: the logged pose's offset from its frame's logged origin (its
-// frame: the newest origin) moved with that origin.
-Eigen::Vector3d ResolvedFinalPosition(const mapping::GraphLogContents& g,
-                                      const std::vector<mapping::GraphFactorRecord>& extra,
-                                      double switch_sigma_scale = 1.0, bool without_tags = false) {
-  mapping::RoverGraph graph;
+// The logged graph re-solved, with `extra` factors, optionally without the
+// tag sightings (v, o) and with the frame switches' sigmas scaled.
+std::unique_ptr<mapping::RoverGraph> Resolved(const mapping::GraphLogContents& g,
+                                              const std::vector<mapping::GraphFactorRecord>& extra,
+                                              double switch_sigma_scale, bool without_tags) {
+  auto graph = std::make_unique<mapping::RoverGraph>();
   for (mapping::GraphFactorRecord f : g.factors) {
     if (without_tags && (f.kind == mapping::FactorKind::kFilterPose ||
                          f.kind == mapping::FactorKind::kLandmarkObservation)) {
@@ -277,11 +278,21 @@ Eigen::Vector3d ResolvedFinalPosition(const mapping::GraphLogContents& g,
     if (f.kind == mapping::FactorKind::kFrameSwitch) {
       f.covariance *= switch_sigma_scale * switch_sigma_scale;
     }
-    mapping::AddToGraph(f, &graph);
+    mapping::AddToGraph(f, graph.get());
   }
-  for (const mapping::GraphFactorRecord& f : extra) mapping::AddToGraph(f, &graph);
-  graph.Optimize();
-  return mapping::MovedFinalGlobalPose(g, graph).translation();
+  for (const mapping::GraphFactorRecord& f : extra) mapping::AddToGraph(f, graph.get());
+  graph->Optimize();
+  return graph;
+}
+
+// The final global pose after re-solving the logged graph, with `extra`
+// factors: the logged pose's offset from its frame's logged origin (its
+// frame: the newest origin) moved with that origin.
+Eigen::Vector3d ResolvedFinalPosition(const mapping::GraphLogContents& g,
+                                      const std::vector<mapping::GraphFactorRecord>& extra,
+                                      double switch_sigma_scale = 1.0, bool without_tags = false) {
+  return mapping::MovedFinalGlobalPose(g, *Resolved(g, extra, switch_sigma_scale, without_tags))
+      .translation();
 }
 
 // Re-solves the logged graph as it is and with false matches added, and
@@ -319,7 +330,8 @@ void ScoreFalseMatches(const mapping::GraphLogContents& g, const Eigen::Isometry
 // With tag sightings in the graph: the logged graph re-solved whole and
 // without them, scored as the logged final position.
 void ScoreTagSightings(const mapping::GraphLogContents& g, const Eigen::Isometry3d& T_world_graph,
-                       const Eigen::Vector3d& p_true, double distance_m, MapResult* r,
+                       const Eigen::Vector3d& p_true, double distance_m,
+                       const std::function<Eigen::Vector3d(int64_t)>& truth_at, MapResult* r,
                        std::ostream& report) {
   uint64_t factors = 0;
   for (const mapping::GraphFactorRecord& f : g.factors) {
@@ -327,8 +339,28 @@ void ScoreTagSightings(const mapping::GraphLogContents& g, const Eigen::Isometry
   }
   r->tag_factors = factors;
   if (factors == 0 || distance_m <= 0.0) return;
-  const Eigen::Vector3d whole = T_world_graph * ResolvedFinalPosition(g, {});
-  const Eigen::Vector3d without = T_world_graph * ResolvedFinalPosition(g, {}, 1.0, true);
+  const std::unique_ptr<mapping::RoverGraph> with_tags = Resolved(g, {}, 1.0, false);
+  const Eigen::Vector3d whole =
+      T_world_graph * mapping::MovedFinalGlobalPose(g, *with_tags).translation();
+  const std::unique_ptr<mapping::RoverGraph> without_tags = Resolved(g, {}, 1.0, true);
+  const Eigen::Vector3d without =
+      T_world_graph * mapping::MovedFinalGlobalPose(g, *without_tags).translation();
+  // Where the graph puts the sighting poses against the truth, with the
+  // sightings and without (their frame's origin and the filter's estimate).
+  std::vector<double> with_m, without_m;
+  for (const mapping::GraphFactorRecord& f : g.factors) {
+    if (f.kind != mapping::FactorKind::kFilterPose) continue;
+    const Eigen::Vector3d truth = truth_at(f.stamp_ns);
+    with_m.push_back((T_world_graph * with_tags->Estimate(*f.b).translation() - truth).norm());
+    without_m.push_back(
+        (T_world_graph * (without_tags->Estimate(f.a) * f.T_a_b).translation() - truth).norm());
+  }
+  if (!with_m.empty()) {
+    report << "  the sighting poses vs truth: median " << Num(stats::Percentile(with_m, 50.0), 3)
+           << " m with the sightings, " << Num(stats::Percentile(without_m, 50.0), 3)
+           << " m without; the last " << Num(with_m.back(), 3) << " m with, "
+           << Num(without_m.back(), 3) << " m without\n";
+  }
   r->slam_resolved_error_pct = 100.0 * (whole - p_true).norm() / distance_m;
   r->slam_without_tags_error_pct = 100.0 * (without - p_true).norm() / distance_m;
   report << "  tag sightings: " << factors << " o factors; the logged graph re-solved: final "
@@ -450,7 +482,13 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
     r->slam_final_error_m = (p_est - p_true).norm();
     r->slam_final_error_pct = distance_m > 0.0 ? 100.0 * r->slam_final_error_m / distance_m
                                                : std::numeric_limits<double>::quiet_NaN();
-    ScoreTagSightings(g, *T_world_graph, p_true, distance_m, r, report);
+    ScoreTagSightings(
+        g, *T_world_graph, p_true, distance_m,
+        [&](int64_t stamp_ns) {
+          return trajectory.Evaluate((Time::FromNanoseconds(stamp_ns) - mission.start).ToSeconds())
+              .p_world_body;
+        },
+        r, report);
     if ((options.false_match_fraction > 0.0 || options.switch_sigma_scale != 1.0) &&
         distance_m > 0.0) {
       ScoreFalseMatches(g, *T_world_graph, p_true, distance_m, options, r, report);

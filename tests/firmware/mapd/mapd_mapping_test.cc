@@ -22,6 +22,10 @@
 #include "firmware/roverd/mapd_link.h"
 #include "mapping/compose/map_export.h"
 #include "mapping/compose/submap_log.h"
+#include "mapping/slam/graph_log.h"
+#include "mapping/tags/tag_image_renderer.h"
+#include "mapping/tags/tag_log.h"
+#include "mapping/tags/tag_pattern.h"
 #include "tests/firmware/mapd/log_topic.h"
 #include "tests/firmware/mapd/stereo_scene.h"
 
@@ -31,6 +35,9 @@ namespace {
 namespace topics = runtime::topics;
 
 ipc::Topic T(std::string_view name) { return *ipc::Topic::Parse(name); }
+
+// Around a rendered tag: pixels that are not the tag's.
+constexpr uint8_t kTagBackgroundDn = 111;
 
 class MapdMappingTest : public ::testing::Test {
  protected:
@@ -54,8 +61,9 @@ class MapdMappingTest : public ::testing::Test {
     std::filesystem::remove_all(dir_, ignored);
   }
 
-  std::unique_ptr<Mapd> MakeMapd() {
+  std::unique_ptr<Mapd> MakeMapd(std::optional<mapping::TagObserverOptions> tags = std::nullopt) {
     MapdOptions options;
+    options.tags = std::move(tags);
     options.pose_queue = 8;
     options.max_mapping_rate_hz = 0.0;
     options.output_stem = (dir_ / "mapd-test").string();
@@ -75,7 +83,8 @@ class MapdMappingTest : public ::testing::Test {
   }
 
   /// A pair captured at `t_s` with the body at world x `world_x_m`.
-  void Frame(Mapd* mapd, double t_s, double world_x_m, uint64_t sequence, int width_px = 0) {
+  void Frame(Mapd* mapd, double t_s, double world_x_m, uint64_t sequence, int width_px = 0,
+             const cv::Mat& tag_rect0 = cv::Mat()) {
     auto m = std::make_unique<topics::StereoFrameMsg>();
     m->width_px = static_cast<uint32_t>(width_px > 0 ? width_px : scene_.width_px);
     m->height_px = static_cast<uint32_t>(scene_.height_px);
@@ -85,6 +94,12 @@ class MapdMappingTest : public ::testing::Test {
     T_world_body.translation().x() = world_x_m;
     scene_.Render(0, T_world_body, m->cam0.data());
     scene_.Render(1, T_world_body, m->cam1.data());
+    if (!tag_rect0.empty()) {
+      // A tag in front of cam0 (the scene's cameras rectify to themselves):
+      // its pixels over the scene's.
+      cv::Mat cam0(scene_.height_px, scene_.width_px, CV_8UC1, m->cam0.data());
+      tag_rect0.copyTo(cam0, tag_rect0 != kTagBackgroundDn);
+    }
     ASSERT_TRUE(frames_->Publish(*m));
     mapd->Poll();
   }
@@ -214,6 +229,69 @@ TEST_F(MapdMappingTest, MapsPairsIntoSubmapsLogsThemAndExportsTheGlobalMap) {
   const mapping::PointCloud cloud =
       mapping::ReadPly(mapd->log_path().substr(0, mapd->log_path().size() - 5) + ".ply");
   EXPECT_GT(cloud.size(), 1000u);
+}
+
+TEST_F(MapdMappingTest, ALandmarkTagSeenInThePairsJoinsTheGraphAndTheLog) {
+  mapping::TagObserverOptions tags;
+  tags.model.kind = mapping::TagErrorModelKind::kAnalytic;  // no table to build
+  tags.detector.quad_decimate = 1.0;                        // a small image
+  mapping::TagMarker post;
+  post.id = 3;
+  post.size_m = 0.16;
+  post.landmark = 9;
+  tags.markers = {post};
+  auto mapd = MakeMapd(tags);
+  const std::optional<calib::StereoRectifier> rectifier =
+      calib::StereoRectifier::Create(scene_.Camera(0), scene_.Camera(1));
+  ASSERT_TRUE(rectifier.has_value());
+  mapping::TagRenderOptions render;
+  render.background_dn = kTagBackgroundDn;
+  render.blur_sigma_px = 0.0;
+  Eigen::Isometry3d T_cam_tag = Eigen::Isometry3d::Identity();
+  T_cam_tag.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T_cam_tag.translation() = Eigen::Vector3d(0.1, -0.1, 1.0);
+  const cv::Mat tag =
+      mapping::RenderTagImage(mapping::MakeTagPattern("tag36h11", 3), 0.16, T_cam_tag,
+                              rectifier->intrinsics(), rectifier->image_size(), render);
+  // An id the marker list does not have: logged, counted, no factor.
+  const cv::Mat unknown =
+      mapping::RenderTagImage(mapping::MakeTagPattern("tag36h11", 8), 0.16, T_cam_tag,
+                              rectifier->intrinsics(), rectifier->image_size(), render);
+  for (int i = 0; i <= 10; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
+  Frame(mapd.get(), 1.05, 0.0, 1, 0, tag);
+  for (int i = 11; i <= 20; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
+  Frame(mapd.get(), 1.15, 0.0, 2, 0, unknown);
+  for (int i = 21; i <= 30; ++i) Pose(mapd.get(), 1.0 + 0.01 * i, 0, 0.0);
+  mapd->Shutdown();
+  EXPECT_EQ(mapd->stats().images_mapped, 2u);
+  EXPECT_EQ(mapd->stats().tag_factors, 1u) << mapd->Summary();
+  EXPECT_EQ(mapd->stats().tag_sightings, 1u);
+  EXPECT_EQ(mapd->tag_stats().observer.not_configured, 1u);
+  EXPECT_NE(mapd->Summary().find("tags: 2 images searched"), std::string::npos) << mapd->Summary();
+  // Both observations are in the log, the known one accepted with its pose.
+  const auto logged = mapping::ReadTagDetections(mapd->log_path());
+  ASSERT_EQ(logged.detections.size(), 2u);
+  EXPECT_EQ(logged.detections[0].id, 3);
+  EXPECT_TRUE(logged.detections[0].accepted) << logged.detections[0].refusal;
+  EXPECT_NEAR(logged.detections[0].pose.position.z, 1.0, 0.02);
+  EXPECT_EQ(logged.detections[1].id, 8);
+  EXPECT_FALSE(logged.detections[1].accepted);
+  // The graph has the sighting's pose (v, in frame 0) and the landmark (o).
+  const mapping::GraphLogContents graph = mapping::ReadGraphLogs({mapd->log_path()});
+  int v = 0, o = 0;
+  for (const mapping::GraphFactorRecord& f : graph.factors) {
+    if (f.kind == mapping::FactorKind::kFilterPose) {
+      ++v;
+      EXPECT_EQ(f.a, mapping::GraphKey::Origin(0, 0));
+    }
+    if (f.kind == mapping::FactorKind::kLandmarkObservation) {
+      ++o;
+      EXPECT_EQ(*f.b, mapping::GraphKey::Landmark(9));
+      EXPECT_TRUE(f.robust);
+    }
+  }
+  EXPECT_EQ(v, 1);
+  EXPECT_EQ(o, 1);
 }
 
 TEST_F(MapdMappingTest, APairOfTheWrongSizeIsCountedAndMappingGoesOn) {

@@ -86,7 +86,7 @@ TEST(TagErrorModelTest, TheTableModelTakesTheLargerOfTableAndSpread) {
   const TagUncertainty u = model.Evaluate(corners, *pose, kTagSizeM, camera);
   ASSERT_TRUE(u.accepted) << u.refusal;
   const TagPoseErrors expected =
-      0.35 *
+      TagErrorModelOptions{}.sigma_per_max_error *
       Table().Lookup(pose->distance_m, pose->tilt_rad).cwiseMax(u.perturbation.max_deviation);
   EXPECT_TRUE(u.sigma.isApprox(expected));
   // Position sigmas across and along the line of sight, turned into the

@@ -136,6 +136,26 @@ TEST(TagObserverTest, LoadsItsConfigurationAndNamesWhatIsWrong) {
                ConfigError);
 }
 
+TEST(TagObserverTest, AnAmbiguousDetectionComesWithBothSolutionsCovariancesAndTheInflatedOne) {
+  TagObserver observer(TwoMarkers(), TestCamera(), kImage, Tables());
+  int ambiguous = 0;
+  // Small, far and nearly head-on: the planar ambiguity at its worst.
+  for (double d = 3.0; d <= 6.0; d += 0.25) {
+    for (const TagObservation& o :
+         observer.Observe(RenderTag(3, 0.16, TagAt(d, 0.1, 0.05), TestCamera()))) {
+      if (!o.uncertainty.ambiguous) continue;
+      ++ambiguous;
+      EXPECT_FALSE(o.accepted);
+      ASSERT_TRUE(o.pose.has_value());
+      EXPECT_TRUE(o.solutions[0].accepted);
+      EXPECT_TRUE(o.solutions[1].accepted);
+      EXPECT_TRUE(o.inflated.accepted);
+      EXPECT_GE(o.inflated.covariance.trace(), o.solutions[0].covariance.trace());
+    }
+  }
+  EXPECT_GT(ambiguous, 0) << "no ambiguous detection to check";
+}
+
 TEST(LoadTagErrorTablesTest, ReadsTheTableOfEachSizeFromTheFolder) {
   const rover::testing::TempDir dir("tag_tables");
   const std::string folder = dir.path().string();

@@ -150,7 +150,9 @@ TEST(BoardConfigTest, ReadsEveryKey) {
       "health: {period_s: 0.5, stale_after_s: 2.0, rate_warn_fraction: 0, watchdog: false}\n"
       "mapd: {submap_max_distance_m: 10.0, submap_max_position_sigma_m: 0.2,"
       " restart_backoff_s: 3.0, switch_along_sigma_per_m: 0.004,"
-      " switch_across_sigma_per_m: 0.002, switch_yaw_sigma_rad_per_m: 0.001}\n");
+      " switch_across_sigma_per_m: 0.002, switch_yaw_sigma_rad_per_m: 0.001,"
+      " tags: /etc/rover/tags.yaml, tag_tables: /etc/rover/tables, build_missing_tag_tables: "
+      "true}\n");
   EXPECT_EQ(c.board.name, "rover-2_b");
   EXPECT_EQ(c.board.profile, BoardProfile::kReplay);
   ASSERT_TRUE(c.replay.has_value());
@@ -183,6 +185,9 @@ TEST(BoardConfigTest, ReadsEveryKey) {
   EXPECT_EQ(c.mapd.switch_along_sigma_per_m, 0.004);
   EXPECT_EQ(c.mapd.switch_across_sigma_per_m, 0.002);
   EXPECT_EQ(c.mapd.switch_yaw_sigma_rad_per_m, 0.001);
+  EXPECT_EQ(c.mapd.tags, "/etc/rover/tags.yaml");
+  EXPECT_EQ(c.mapd.tag_tables, "/etc/rover/tables");
+  EXPECT_TRUE(c.mapd.build_missing_tag_tables);
 }
 
 TEST(BoardConfigTest, PartialThreadSectionKeepsThatThreadsDefaults) {
