@@ -753,29 +753,19 @@ void Mapd::TakeTagResults() {
 void Mapd::HandleTagObservation(const TagSighting& sighting, mapping::TagObservation o) {
   const bool landmark =
       o.marker != nullptr && o.marker->carrier == mapping::TagMarker::Carrier::kLandmark;
-  const auto T_local_tag = [&](const Eigen::Isometry3d& T_cam_tag) {
-    return sighting.T_local_body * mapper_->T_body_cam() * T_cam_tag;
-  };
+  const Eigen::Isometry3d T_local_cam = sighting.T_local_body * mapper_->T_body_cam();
   if (landmark && o.accepted) {
     LogTag(sighting, o);
     AddTagFactor(sighting, o);
     // It votes for where the tag is, for the ambiguous sightings.
-    ApplyTagDecisions(tag_resolver_.Add({.key = 0,
-                                         .stamp_ns = sighting.stamp_ns,
-                                         .tag_id = o.detection.id,
-                                         .frame_id = sighting.frame_id,
-                                         .T_local_tag = {T_local_tag(o.pose->best.T_camera_tag)}}));
+    ApplyTagDecisions(tag_resolver_.Add(
+        mapping::PlacementsOf(o, T_local_cam, 0, sighting.stamp_ns, sighting.frame_id)));
     return;
   }
   if (landmark && o.uncertainty.ambiguous && o.pose && slam_) {
     const uint64_t key = next_tag_key_++;
-    const mapping::TagPlacements placements{
-        .key = key,
-        .stamp_ns = sighting.stamp_ns,
-        .tag_id = o.detection.id,
-        .frame_id = sighting.frame_id,
-        .T_local_tag = {T_local_tag(o.pose->best.T_camera_tag),
-                        T_local_tag(o.pose->alternative.T_camera_tag)}};
+    const mapping::TagPlacements placements =
+        mapping::PlacementsOf(o, T_local_cam, key, sighting.stamp_ns, sighting.frame_id);
     waiting_tags_.emplace(key, std::pair{sighting, std::move(o)});
     ApplyTagDecisions(tag_resolver_.Add(placements));
     return;

@@ -21,9 +21,28 @@ TagDecision Undecided(const TagPlacements& s, std::string why) {
 
 }  // namespace
 
+TagPlacements PlacementsOf(const TagObservation& o, const Eigen::Isometry3d& T_local_cam,
+                           uint64_t key, int64_t stamp_ns, uint32_t frame_id) {
+  TagPlacements p{.key = key, .stamp_ns = stamp_ns, .tag_id = o.detection.id, .frame_id = frame_id};
+  const auto add = [&](const Eigen::Isometry3d& T_camera_tag, const TagUncertainty& u) {
+    p.T_local_tag.push_back(T_local_cam * T_camera_tag);
+    p.rotation_sigma_rad.push_back(u.sigma.tail<3>().maxCoeff());
+    p.position_sigma_m.push_back(u.sigma.head<3>().maxCoeff());
+  };
+  if (!o.pose) return p;
+  if (o.accepted) {
+    add(o.pose->best.T_camera_tag, o.uncertainty);
+  } else if (o.uncertainty.ambiguous) {
+    add(o.pose->best.T_camera_tag, o.solutions[0]);
+    add(o.pose->alternative.T_camera_tag, o.solutions[1]);
+  }
+  return p;
+}
+
 void TagAmbiguityOptions::Validate() const {
   Require(agree_rad > 0.0 && agree_rad < 1.0, "agree_rad", "in (0, 1) rad");
   Require(agree_m > 0.0 && std::isfinite(agree_m), "agree_m", "> 0 m");
+  Require(agree_sigmas >= 0.0 && std::isfinite(agree_sigmas), "agree_sigmas", ">= 0");
   Require(min_support >= 2, "min_support", ">= 2 sightings");
   Require(max_rival_fraction >= 0.0 && max_rival_fraction < 1.0, "max_rival_fraction", "in [0, 1)");
   Require(max_wait_s > 0.0 && std::isfinite(max_wait_s), "max_wait_s", "> 0 s");
@@ -34,10 +53,21 @@ TagAmbiguityResolver::TagAmbiguityResolver(const TagAmbiguityOptions& options) :
   options_.Validate();
 }
 
-bool TagAmbiguityResolver::Agree(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const {
-  const double angle = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
-  return angle <= options_.agree_rad &&
-         (a.translation() - b.translation()).norm() <= options_.agree_m;
+bool TagAmbiguityResolver::Agree(const TagPlacements& a, std::size_t i, const TagPlacements& b,
+                                 std::size_t j) const {
+  const auto sigma = [](const std::vector<double>& v, std::size_t k) {
+    return k < v.size() ? v[k] : 0.0;
+  };
+  const double max_rad = std::max(
+      options_.agree_rad, options_.agree_sigmas * std::hypot(sigma(a.rotation_sigma_rad, i),
+                                                             sigma(b.rotation_sigma_rad, j)));
+  const double max_m =
+      std::max(options_.agree_m, options_.agree_sigmas * std::hypot(sigma(a.position_sigma_m, i),
+                                                                    sigma(b.position_sigma_m, j)));
+  const Eigen::Isometry3d& A = a.T_local_tag[i];
+  const Eigen::Isometry3d& B = b.T_local_tag[j];
+  return Eigen::AngleAxisd(A.linear().transpose() * B.linear()).angle() <= max_rad &&
+         (A.translation() - B.translation()).norm() <= max_m;
 }
 
 std::size_t TagAmbiguityResolver::waiting() const {
@@ -52,6 +82,12 @@ std::vector<TagDecision> TagAmbiguityResolver::Add(const TagPlacements& sighting
   if (sighting.T_local_tag.empty() || sighting.T_local_tag.size() > 2) {
     throw std::invalid_argument("TagAmbiguityResolver::Add: expected 1 or 2 placements, found " +
                                 std::to_string(sighting.T_local_tag.size()));
+  }
+  const std::size_t n = sighting.T_local_tag.size();
+  if ((!sighting.rotation_sigma_rad.empty() && sighting.rotation_sigma_rad.size() != n) ||
+      (!sighting.position_sigma_m.empty() && sighting.position_sigma_m.size() != n)) {
+    throw std::invalid_argument(
+        "TagAmbiguityResolver::Add: expected one sigma per placement or none");
   }
   std::vector<TagDecision> out;
   // A new frame: the waiting sightings of earlier ones can no longer be
@@ -88,44 +124,48 @@ void TagAmbiguityResolver::Decide(Group* g, std::vector<TagDecision>* out) const
   bool any_waiting = false;
   for (const bool w : g->waiting) any_waiting = any_waiting || w;
   if (!any_waiting) return;
-  // Support of a placement: the sightings with a solution that agrees with it.
-  const auto support = [&](const Eigen::Isometry3d& T) {
+  const std::vector<TagPlacements>& all = g->sightings;
+  // Support of placement (s, i): the sightings with a solution that agrees.
+  const auto support = [&](std::size_t s, std::size_t i) {
     int n = 0;
-    for (const TagPlacements& s : g->sightings) {
+    for (const TagPlacements& other : all) {
       bool agrees = false;
-      for (const Eigen::Isometry3d& other : s.T_local_tag) agrees = agrees || Agree(T, other);
+      for (std::size_t j = 0; j < other.T_local_tag.size() && !agrees; ++j) {
+        agrees = Agree(all[s], i, other, j);
+      }
       n += agrees;
     }
     return n;
   };
-  const Eigen::Isometry3d* best = nullptr;
+  std::size_t best_s = 0, best_i = 0;
   int best_support = 0;
-  for (const TagPlacements& s : g->sightings) {
-    for (const Eigen::Isometry3d& T : s.T_local_tag) {
-      const int n = support(T);
+  for (std::size_t s = 0; s < all.size(); ++s) {
+    for (std::size_t i = 0; i < all[s].T_local_tag.size(); ++i) {
+      const int n = support(s, i);
       if (n > best_support) {
         best_support = n;
-        best = &T;
+        best_s = s;
+        best_i = i;
       }
     }
   }
-  if (best == nullptr || best_support < options_.min_support) return;
+  if (best_support < options_.min_support) return;
   int rival_support = 0;
-  for (const TagPlacements& s : g->sightings) {
-    for (const Eigen::Isometry3d& T : s.T_local_tag) {
-      if (!Agree(T, *best)) rival_support = std::max(rival_support, support(T));
+  for (std::size_t s = 0; s < all.size(); ++s) {
+    for (std::size_t i = 0; i < all[s].T_local_tag.size(); ++i) {
+      if (!Agree(all[s], i, all[best_s], best_i))
+        rival_support = std::max(rival_support, support(s, i));
     }
   }
   if (rival_support > options_.max_rival_fraction * best_support) return;
-  for (std::size_t k = 0; k < g->sightings.size(); ++k) {
+  for (std::size_t k = 0; k < all.size(); ++k) {
     if (!g->waiting[k]) continue;
     g->waiting[k] = false;
-    const TagPlacements& s = g->sightings[k];
     TagDecision d;
-    d.key = s.key;
+    d.key = all[k].key;
     d.support = best_support;
-    for (int i = 0; i < static_cast<int>(s.T_local_tag.size()) && d.solution < 0; ++i) {
-      if (Agree(s.T_local_tag[static_cast<std::size_t>(i)], *best)) d.solution = i;
+    for (std::size_t i = 0; i < all[k].T_local_tag.size() && d.solution < 0; ++i) {
+      if (Agree(all[k], i, all[best_s], best_i)) d.solution = static_cast<int>(i);
     }
     if (d.solution < 0) {
       d.refusal = "ambiguous, and neither solution agrees with the tag's other sightings";

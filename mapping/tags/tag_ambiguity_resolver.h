@@ -19,13 +19,17 @@
 #include <utility>
 #include <vector>
 
+#include "mapping/tags/tag_observer.h"
+
 namespace rover::mapping {
 
 struct TagAmbiguityOptions {
   /// Two placements of the tag agree within this rotation [rad] and
-  /// distance between the tag centres [m].
+  /// distance between the tag centres [m], or within agree_sigmas of their
+  /// combined standard deviations where those are larger.
   double agree_rad = 5.0 * 3.14159265358979323846 / 180.0;
   double agree_m = 0.10;
+  double agree_sigmas = 2.5;
   /// Sightings that must agree on a placement before it is taken.
   int min_support = 4;
   /// ... and the best rival placement may have at most this fraction of its
@@ -50,6 +54,10 @@ struct TagPlacements {
   uint32_t frame_id = 0;
   /// T_local_tag of each solution (best first).
   std::vector<Eigen::Isometry3d> T_local_tag{};
+  /// Each solution's largest rotation [rad] and position [m] standard
+  /// deviation (empty: agree_rad and agree_m alone decide).
+  std::vector<double> rotation_sigma_rad{};
+  std::vector<double> position_sigma_m{};
 };
 
 struct TagDecision {
@@ -62,6 +70,12 @@ struct TagDecision {
   std::string refusal;  ///< why no solution was chosen
   int support = 0;      ///< sightings that agreed with the chosen placement
 };
+
+/// The placements an observation of a tag seen from T_local_cam gives: its
+/// best solution if accepted (a vote), both solutions if ambiguous (to be
+/// decided), none otherwise; with their sigmas.
+TagPlacements PlacementsOf(const TagObservation& observation, const Eigen::Isometry3d& T_local_cam,
+                           uint64_t key, int64_t stamp_ns, uint32_t frame_id);
 
 class TagAmbiguityResolver {
  public:
@@ -87,7 +101,8 @@ class TagAmbiguityResolver {
   };
   /// Decides the waiting sightings of `group` if its placements allow.
   void Decide(Group* group, std::vector<TagDecision>* out) const;
-  bool Agree(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const;
+  /// Placement i of sighting a against placement j of sighting b.
+  bool Agree(const TagPlacements& a, std::size_t i, const TagPlacements& b, std::size_t j) const;
 
   TagAmbiguityOptions options_;
   std::map<std::pair<uint32_t, int>, Group> groups_;  ///< by (frame, tag id)

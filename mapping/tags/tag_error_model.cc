@@ -109,7 +109,7 @@ TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& cor
 TagUncertainty TagErrorModel::Inflated(const TagPose& pose, const TagUncertainty& best) {
   TagUncertainty u = best;
   if (!u.accepted) return u;
-  const TagPoseErrors d = TagPoseError(pose.best.T_camera_tag, pose.alternative.T_camera_tag);
+  const TagPoseErrors d = 2.0 * TagPoseError(pose.best.T_camera_tag, pose.alternative.T_camera_tag);
   u.covariance += d * d.transpose();
   u.sigma = u.covariance.diagonal().cwiseSqrt();
   u.ambiguous = true;
@@ -117,11 +117,16 @@ TagUncertainty TagErrorModel::Inflated(const TagPose& pose, const TagUncertainty
 }
 
 TagUncertainty TagErrorModel::ForSolution(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
-                                          const calib::RectifiedIntrinsics& camera) const {
+                                          const calib::RectifiedIntrinsics& camera,
+                                          const CornerPerturbation* perturbation) const {
   TagUncertainty u;
   if (options_.kind == TagErrorModelKind::kTable) {
-    u.sigma = options_.sigma_per_max_error *
-              table_->Lookup(T_camera_tag.translation().norm(), TagTilt(T_camera_tag));
+    TagPoseErrors max_error =
+        table_->Lookup(T_camera_tag.translation().norm(), TagTilt(T_camera_tag));
+    if (perturbation != nullptr) {
+      max_error.head<3>() = max_error.head<3>().cwiseMax(perturbation->max_deviation.head<3>());
+    }
+    u.sigma = options_.sigma_per_max_error * max_error;
     u.covariance = LineOfSightCovariance(u.sigma, T_camera_tag.translation());
   } else {
     u.covariance =

@@ -89,17 +89,20 @@ class TagErrorModel {
 
   /// The covariance of one solution chosen by other means (an ambiguous
   /// detection that the tag's other sightings decide): the table at that
-  /// solution's distance and tilt, or the analytic model; no perturbation
-  /// and no ambiguity check. Not accepted only if degenerate.
+  /// solution's distance and tilt, or the analytic model; no ambiguity
+  /// check. With `perturbation` (of the detection's corners), its position
+  /// spread counts too (the rotation spread mixes both solutions). Not
+  /// accepted only if degenerate.
   TagUncertainty ForSolution(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
-                             const calib::RectifiedIntrinsics& camera) const;
+                             const calib::RectifiedIntrinsics& camera,
+                             const CornerPerturbation* perturbation = nullptr) const;
 
   /// The thesis's other way with an unstable pose, for an ambiguous
   /// detection nothing decides: inflated so that it claims neither
   /// solution's rotation. `best` (ForSolution of pose.best) plus the outer
-  /// product of the difference between the two solutions: the alternative
-  /// lies one sigma away along it, while the position, which both solutions
-  /// share to millimetres, keeps nearly its own sigma.
+  /// product of twice the difference between the two solutions: the
+  /// alternative lies half a sigma away along it, while the position, which
+  /// both solutions share to millimetres, keeps nearly its own sigma.
   static TagUncertainty Inflated(const TagPose& pose, const TagUncertainty& best);
 
   const TagErrorModelOptions& options() const { return options_; }

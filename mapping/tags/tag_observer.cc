@@ -200,9 +200,10 @@ std::vector<TagObservation> TagObserver::Observe(const cv::Mat& rectified) {
     const TagErrorModel& model = models_.at(SizeKey(o.marker->size_m));
     o.uncertainty = model.Evaluate(d.corners_px, *o.pose, o.marker->size_m, camera_);
     if (o.uncertainty.ambiguous) {
-      o.solutions = {
-          model.ForSolution(o.pose->best.T_camera_tag, o.marker->size_m, camera_),
-          model.ForSolution(o.pose->alternative.T_camera_tag, o.marker->size_m, camera_)};
+      o.solutions = {model.ForSolution(o.pose->best.T_camera_tag, o.marker->size_m, camera_,
+                                       &o.uncertainty.perturbation),
+                     model.ForSolution(o.pose->alternative.T_camera_tag, o.marker->size_m, camera_,
+                                       &o.uncertainty.perturbation)};
       o.inflated = TagErrorModel::Inflated(*o.pose, o.solutions[0]);
     }
     o.accepted = o.uncertainty.accepted;
