@@ -13,6 +13,7 @@ namespace rover::sim::experiments {
 namespace {
 
 constexpr double kChi2Six95 = 12.592;
+constexpr double kChi2Three95 = 7.815;
 constexpr double kDeg = M_PI / 180.0;
 
 // T_world_tag of every tag on a static carrier, by id.
@@ -57,7 +58,10 @@ TagScore ScoreTagDetections(const std::vector<log::rover_msgs::TagDetection>& de
     rotation_deg.push_back(e.tail<3>().norm() / kDeg);
     const bool wrong = e.tail<3>().norm() > 20.0 * kDeg;
     s.wrong_solutions += wrong;
-    s.wrong_solutions_claimed += wrong && x > kChi2Six95;
+    const Eigen::Vector3d e_rotation = e.tail<3>();
+    const Eigen::Matrix3d rotation_covariance = covariance.bottomRightCorner<3, 3>();
+    const double rotation_nees = e_rotation.dot(rotation_covariance.ldlt().solve(e_rotation));
+    s.wrong_solutions_claimed += wrong && rotation_nees > kChi2Three95;
     s.normalized_rms += e.cwiseQuotient(covariance.diagonal().cwiseSqrt()).cwiseAbs2();
     s.mean_position_error_m += e.head<3>();
   }
@@ -81,7 +85,8 @@ void ReportTagScore(const TagScore& s, std::ostream& report) {
                 "  tags vs truth: %llu observations logged, %llu accepted, %llu on landmarks "
                 "scored: NEES within the chi^2(6) 95 %% bound for %.1f %% (median %.2f, mean "
                 "%.2f; 6 if consistent), error median %.2f %% of the distance and %.2f deg, %llu "
-                "wrong solutions (%llu not covered by their covariance); error over sigma (RMS) x "
+                "wrong solutions (%llu whose rotation covariance does not cover them); error over "
+                "sigma (RMS) x "
                 "%.2f y %.2f z %.2f, roll %.2f pitch "
                 "%.2f yaw %.2f; mean position error %+.1f %+.1f %+.1f mm (camera)\n",
                 static_cast<unsigned long long>(s.decoded),

@@ -33,8 +33,9 @@ struct TagScore {
   double position_error_pct_median = std::numeric_limits<double>::quiet_NaN();
   double rotation_error_deg_median = std::numeric_limits<double>::quiet_NaN();
   /// Accepted poses more than 20 deg off: the wrong solution of the planar
-  /// ambiguity; and of those, the ones whose covariance does not cover the
-  /// error (NEES beyond the bound): a wrong rotation claimed.
+  /// ambiguity; and of those, the ones whose rotation covariance does not
+  /// cover the rotation error (its NEES beyond the chi^2(3) 95 % bound,
+  /// 7.81): a wrong rotation claimed.
   uint64_t wrong_solutions = 0;
   uint64_t wrong_solutions_claimed = 0;
   /// RMS of each error over its stated sigma (dx dy dz [camera], droll

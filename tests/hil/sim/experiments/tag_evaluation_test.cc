@@ -66,7 +66,19 @@ TEST(TagEvaluationTest, ScoresAcceptedLandmarkDetectionsAgainstTheTruth) {
   EXPECT_NEAR(s.nees_in_bound_pct, 100.0 / 3.0, 1e-9);
   EXPECT_NEAR(s.nees_median, 25.0, 1e-6);
   EXPECT_EQ(s.wrong_solutions, 1u);
+  EXPECT_EQ(s.wrong_solutions_claimed, 1u) << "0.01 rad sigma does not cover 40 deg";
   EXPECT_NEAR(s.position_error_pct_median, 0.0, 1e-9);  // of 0, 1.3 and 0 %
+}
+
+TEST(TagEvaluationTest, AWrongRotationLeftOpenIsNotClaimed) {
+  const World world = OnePostWorld();
+  Eigen::Isometry3d flipped = Eigen::Isometry3d::Identity();
+  flipped.linear() = Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
+  log::rover_msgs::TagDetection open = Detection(world, 2, flipped, 0.01);
+  for (int i = 3; i < 6; ++i) open.covariance[static_cast<std::size_t>(7 * i)] = 1.0;  // 57 deg
+  const TagScore s = ScoreTagDetections({open}, world, [](Time) { return T_world_cam(); });
+  EXPECT_EQ(s.wrong_solutions, 1u);
+  EXPECT_EQ(s.wrong_solutions_claimed, 0u);
 }
 
 TEST(TagEvaluationTest, NothingScoredGivesNan) {
