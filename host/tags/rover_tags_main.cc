@@ -15,7 +15,9 @@ int main(int argc, char** argv) {
       "error table of the thesis's model (maximum pose errors over distance and tilt, from tags\n"
       "rendered at each grid pose, detected, their corners perturbed by +-delta px in all 256\n"
       "combinations) for a board's rectified camera, a family and a tag size, and writes it\n"
-      "next to the board's calibration."};
+      "next to the board's calibration. mapd reads it from the board profile's mapd.tag_tables\n"
+      "folder (copy it there, or point tag_tables at the calibration's folder) for every marker\n"
+      "size of its marker file."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rover-tags 0.1.0");
 
