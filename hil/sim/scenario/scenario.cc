@@ -1,8 +1,10 @@
 #include "hil/sim/scenario/scenario.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 #include <stdexcept>
 
 namespace rover::sim {
@@ -45,6 +47,10 @@ WorldOptions LoadWorldOptions(const ConfigNode& node) {
   return o;
 }
 
+// How far inside the world's edge every route point and placed post must
+// stay [m]: the rover stands on the heightfield with ground around it.
+constexpr double kRouteMarginM = 5.0;
+
 std::string EnvOr(const char* name, const std::string& fallback) {
   const char* value = std::getenv(name);
   return value != nullptr && *value != '\0' ? value : fallback;
@@ -74,6 +80,30 @@ Scenario LoadScenario(const std::string& path, const std::string& config_dir) {
   };
   keep_clear(s.route);
   for (const Route& other : s.other_rover_routes) keep_clear(other);
+  // A route that leaves the world drives off the heightfield: the cameras
+  // see nothing there and the filter's VO fails, silently.
+  const double half_m = 0.5 * s.world.size_m - kRouteMarginM;
+  const auto check_inside = [&](const std::string& key, const std::string& what,
+                                const Eigen::Vector2d& xy) {
+    if (std::abs(xy.x()) > half_m || std::abs(xy.y()) > half_m) {
+      std::ostringstream why;
+      why << what << " at (" << xy.x() << ", " << xy.y() << ") m is outside the " << s.world.size_m
+          << " m world (expected |x| and |y| <= " << half_m << " m, " << kRouteMarginM
+          << " m inside its edge; make world.size_m larger)";
+      root.Fail(key, why.str());
+    }
+  };
+  const auto check_route = [&](const Route& route, const std::string& key) {
+    check_inside(key, "the start", route.start_xy_m);
+    for (std::size_t k = 0; k < route.waypoints.size(); ++k) {
+      check_inside(key, "waypoint " + std::to_string(k), route.waypoints[k].xy_m);
+    }
+  };
+  check_route(s.route, "route");
+  for (const Route& other : s.other_rover_routes) check_route(other, "other_rovers");
+  for (std::size_t k = 0; k < s.world.landmark_posts_xy_m.size(); ++k) {
+    check_inside("world", "landmark post " + std::to_string(k), s.world.landmark_posts_xy_m[k]);
+  }
   // With other rovers around, every rover carries tags: sightings are mutual.
   s.world.recording_rover_carries_tags = !s.other_rover_routes.empty();
   if (static_cast<int>(s.other_rover_routes.size()) != s.world.other_rover_count) {

@@ -146,5 +146,22 @@ TEST(ScenarioTest, UnknownKeyIsAnErrorWithFileAndLine) {
   }
 }
 
+TEST(ScenarioTest, ARouteLeavingTheWorldIsRefusedWithTheWaypoint) {
+  const testing::TempDir dir("scenario");
+  const std::string path = dir.File("off_the_edge.yaml").string();
+  std::ofstream(path) << "name: off_the_edge\ndescription: x\nworld: {size_m: 90}\nroute:\n"
+                         "  start_xy_m: [0, 0]\n  start_yaw_rad: 0\n"
+                         "  waypoints:\n    - {xy_m: [30, 0], speed_m_s: 0.3}\n    - {xy_m: [52, "
+                         "0], speed_m_s: 0.3}\n"
+                         "sensors:\n  imu_config: imu_mti10.yaml\n";
+  try {
+    LoadScenario(path, DefaultSimConfigDir());
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("waypoint 1 at (52, 0) m is outside the 90 m world"));
+    EXPECT_THAT(e.what(), HasSubstr("<= 40 m"));
+  }
+}
+
 }  // namespace
 }  // namespace rover::sim
