@@ -771,8 +771,7 @@ void Mapd::HandleTagObservation(const TagSighting& sighting, mapping::TagObserva
     return;
   }
   if (o.accepted && o.marker != nullptr) ++stats_.robot_tags_seen;  // a d factor needs its graph
-  if (o.marker == nullptr && o.refusal.find("not in the configuration") != std::string::npos &&
-      unknown_tag_ids_.insert(o.detection.id).second) {
+  if (o.not_configured && unknown_tag_ids_.insert(o.detection.id).second) {
     std::fprintf(stderr, "mapd: AprilTag id %d is not in the marker list: ignored\n",
                  o.detection.id);
   }

@@ -184,6 +184,7 @@ std::vector<TagObservation> TagObserver::Observe(const cv::Mat& rectified) {
       if (m.id == d.id) o.marker = &m;
     }
     if (o.marker == nullptr) {
+      o.not_configured = true;
       o.refusal = "tag id " + std::to_string(d.id) + " is not in the configuration";
       ++stats_.not_configured;
       out.push_back(std::move(o));

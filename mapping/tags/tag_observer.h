@@ -64,7 +64,10 @@ struct TagObserverOptions {
 
 struct TagObservation {
   TagDetection detection;
-  const TagMarker* marker = nullptr;  ///< null: an id not in the configuration
+  /// Null for an id not in the configuration and for a tag the detector
+  /// refused (its id may be misread).
+  const TagMarker* marker = nullptr;
+  bool not_configured = false;  ///< decoded cleanly, but the id is not in the configuration
   std::optional<TagPose> pose;
   TagUncertainty uncertainty;
   bool accepted = false;

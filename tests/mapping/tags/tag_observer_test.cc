@@ -84,6 +84,7 @@ TEST(TagObserverTest, AnIdNotConfiguredIsRefusedAndCounted) {
   ASSERT_EQ(seen.size(), 1u);
   EXPECT_FALSE(seen[0].accepted);
   EXPECT_EQ(seen[0].refusal, "tag id 9 is not in the configuration");
+  EXPECT_TRUE(seen[0].not_configured);
   EXPECT_EQ(observer.stats().not_configured, 1u);
   EXPECT_EQ(observer.stats().accepted, 0u);
 }
