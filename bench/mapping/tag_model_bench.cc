@@ -13,7 +13,11 @@
 //
 //   bench_tag_model [--samples N] [--seed S] [--table-steps N] [--delta-px X]
 //                   [--corner-sigma-px X] [--sigma-per-max X] [--max-flipped F]
-//                   [--max-ambiguity R] [--decimate D]
+//                   [--max-ambiguity R] [--decimate D] [--csv PATH]
+//
+// --csv writes one row per accepted detection and model: the truth's
+// distance and tilt, the rendering, the error in the line-of-sight frame,
+// the model's sigmas and the NEES, to see where a model is off.
 
 #include <chrono>
 #include <cmath>
@@ -57,6 +61,7 @@ struct Args {
   double max_flipped = TagErrorModelOptions{}.max_flipped_fraction;
   double max_ambiguity = TagErrorModelOptions{}.max_ambiguity_ratio;
   double decimate = TagDetectorOptions{}.quad_decimate;
+  std::string csv_path;
 };
 
 Args Parse(int argc, char** argv) {
@@ -88,6 +93,8 @@ Args Parse(int argc, char** argv) {
       a.max_ambiguity = std::atof(next());
     else if (s == "--decimate")
       a.decimate = std::atof(next());
+    else if (s == "--csv")
+      a.csv_path = next();
     else {
       std::fprintf(stderr, "unknown argument %s (see the comment at the top of the source)\n",
                    s.c_str());
@@ -130,6 +137,7 @@ int Run(int argc, char** argv) {
               args.table_steps, table.detected_cells(), Ms(start) / 1e3);
 
   TagErrorModelOptions table_options;
+  table_options.kind = TagErrorModelKind::kTable;
   table_options.corner_delta_px = args.delta_px;
   table_options.sigma_per_max_error = args.sigma_per_max;
   table_options.max_flipped_fraction = args.max_flipped;
@@ -148,6 +156,17 @@ int Run(int argc, char** argv) {
   ModelStats stats[2];
   int rendered = 0, detected = 0, near_total = 0, near_accurate = 0, wrong_solutions = 0;
   std::vector<double> detect_ms, full_ms;
+  FILE* csv = args.csv_path.empty() ? nullptr : std::fopen(args.csv_path.c_str(), "w");
+  if (!args.csv_path.empty() && csv == nullptr) {
+    std::fprintf(stderr, "cannot write %s\n", args.csv_path.c_str());
+    return 1;
+  }
+  if (csv)
+    std::fprintf(csv,
+                 "model,distance_m,tilt_deg,blur_px,noise_dn,contrast_dn,"
+                 "e_across1_m,e_across2_m,e_along_m,e_rx_rad,e_ry_rad,e_rz_rad,"
+                 "s_across1_m,s_across2_m,s_along_m,s_rx_rad,s_ry_rad,s_rz_rad,"
+                 "nees,nees_position,nees_rotation,flipped,upright\n");
   for (int n = 0; n < args.samples; ++n) {
     const double d = 0.3 + 6.7 * unit(rng);
     const double tilt = (-80.0 + 160.0 * unit(rng)) * kDeg;
@@ -157,13 +176,17 @@ int Run(int argc, char** argv) {
     const Eigen::Vector3d ray =
         Eigen::Vector3d((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0).normalized();
     // Tilt measured from the line of sight: turn the head-on tag about an
-    // axis across it.
+    // axis across it. Half the tags upright (roll within 5 degrees), as on
+    // posts and robots, whose edges run along the pixel grid; half at any
+    // roll.
+    const bool upright = unit(rng) < 0.5;
+    const double roll_rad = upright ? (unit(rng) - 0.5) * 10.0 * kDeg : unit(rng) * 2.0 * M_PI;
     const Eigen::Matrix3d face_camera =
         Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), ray).toRotationMatrix();
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = face_camera * Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitY()) *
                  Eigen::AngleAxisd((unit(rng) - 0.5) * 40.0 * kDeg, Eigen::Vector3d::UnitX()) *
-                 Eigen::AngleAxisd(unit(rng) * 2.0 * M_PI, Eigen::Vector3d::UnitZ());
+                 Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitZ());
     T.translation() = d * ray;
     TagRenderOptions render;
     render.blur_sigma_px = 0.3 + 0.8 * unit(rng);
@@ -211,8 +234,24 @@ int Run(int argc, char** argv) {
       const double nees = e.dot(unc.covariance.ldlt().solve(e));
       s.nees.push_back(nees);
       s.nees_in_bound += nees <= kChi2Six95;
+      if (csv) {
+        const Eigen::Matrix3d R = LineOfSightRotation(pose->best.T_camera_tag.translation());
+        const Eigen::Vector3d e_los = R.transpose() * e.head<3>();
+        const double nees_p =
+            e.head<3>().dot(unc.covariance.topLeftCorner<3, 3>().ldlt().solve(e.head<3>()));
+        const double nees_r =
+            e.tail<3>().dot(unc.covariance.bottomRightCorner<3, 3>().ldlt().solve(e.tail<3>()));
+        std::fprintf(csv, "%d,%.3f,%.2f,%.2f,%.2f,%d,", m, d, tilt / kDeg, render.blur_sigma_px,
+                     render.noise_sigma_dn, render.white_dn - render.black_dn);
+        for (int k = 0; k < 3; ++k) std::fprintf(csv, "%.6g,", e_los[k]);
+        for (int k = 3; k < 6; ++k) std::fprintf(csv, "%.6g,", e[k]);
+        for (int k = 0; k < 6; ++k) std::fprintf(csv, "%.6g,", unc.sigma[k]);
+        std::fprintf(csv, "%.4g,%.4g,%.4g,%d,%d\n", nees, nees_p, nees_r, unc.perturbation.flipped,
+                     upright ? 1 : 0);
+      }
     }
   }
+  if (csv) std::fclose(csv);
   std::printf("samples %d: %d rendered, %d detected, %d with the wrong solution of the ambiguity\n",
               args.samples, rendered, detected, wrong_solutions);
   std::printf(
