@@ -62,6 +62,10 @@ TagScore ScoreTagDetections(const std::vector<log::rover_msgs::TagDetection>& de
     const Eigen::Matrix3d rotation_covariance = covariance.bottomRightCorner<3, 3>();
     const double rotation_nees = e_rotation.dot(rotation_covariance.ldlt().solve(e_rotation));
     s.wrong_solutions_claimed += wrong && rotation_nees > kChi2Three95;
+    if (wrong) {
+      s.wrong.push_back({log::FromRosTime(d.header.stamp), d.id, distance_m, d.tilt_rad / kDeg,
+                         d.ambiguity_ratio, d.flipped, e.tail<3>().norm() / kDeg, rotation_nees});
+    }
     s.normalized_rms += e.cwiseQuotient(covariance.diagonal().cwiseSqrt()).cwiseAbs2();
     s.mean_position_error_m += e.head<3>();
   }
@@ -99,6 +103,16 @@ void ReportTagScore(const TagScore& s, std::ostream& report) {
                 s.normalized_rms(5), 1e3 * s.mean_position_error_m.x(),
                 1e3 * s.mean_position_error_m.y(), 1e3 * s.mean_position_error_m.z());
   report << text;
+  for (const WrongTagSolution& w : s.wrong) {
+    std::snprintf(text, sizeof(text),
+                  "    wrong solution: tag %d at %.3f s, %.2f m, tilt %+.1f deg, ambiguity ratio "
+                  "%.2f, %u of 256 perturbed poses flipped; rotation off by %.1f deg, NEES %.1f "
+                  "(%s)\n",
+                  w.id, w.stamp.ToSeconds(), w.distance_m, w.tilt_deg, w.ambiguity_ratio, w.flipped,
+                  w.rotation_error_deg, w.rotation_nees,
+                  w.rotation_nees > kChi2Three95 ? "claimed" : "covered");
+    report << text;
+  }
 }
 
 }  // namespace rover::sim::experiments

@@ -21,6 +21,21 @@
 
 namespace rover::sim::experiments {
 
+/// An accepted detection whose pose took the wrong solution of the planar
+/// ambiguity (rotation more than 20 deg off), as logged.
+struct WrongTagSolution {
+  Time stamp;
+  int id = 0;
+  double distance_m = 0.0;
+  double tilt_deg = 0.0;
+  double ambiguity_ratio = 0.0;
+  uint32_t flipped = 0;  ///< of the 256 perturbed poses
+  double rotation_error_deg = 0.0;
+  /// Under the logged rotation covariance; beyond 7.81 the detection claims
+  /// the wrong rotation.
+  double rotation_nees = 0.0;
+};
+
 struct TagScore {
   uint64_t decoded = 0;        ///< logged observations (accepted or refused)
   uint64_t accepted = 0;       ///< of those, accepted
@@ -38,6 +53,7 @@ struct TagScore {
   /// 7.81): a wrong rotation claimed.
   uint64_t wrong_solutions = 0;
   uint64_t wrong_solutions_claimed = 0;
+  std::vector<WrongTagSolution> wrong;  ///< each of wrong_solutions
   /// RMS of each error over its stated sigma (dx dy dz [camera], droll
   /// dpitch dyaw [tag]): 1 where the covariance is right for that axis.
   Eigen::Matrix<double, 6, 1> normalized_rms = Eigen::Matrix<double, 6, 1>::Zero();
@@ -52,7 +68,7 @@ TagScore ScoreTagDetections(const std::vector<log::rover_msgs::TagDetection>& de
                             const World& world,
                             const std::function<Eigen::Isometry3d(Time)>& T_world_cam_at);
 
-/// One report line ("  tags vs truth: ...").
+/// One report line ("  tags vs truth: ..."), and one per wrong solution.
 void ReportTagScore(const TagScore& score, std::ostream& report);
 
 }  // namespace rover::sim::experiments

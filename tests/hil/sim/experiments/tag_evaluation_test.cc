@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "core/log/msgs/builtin_interfaces.h"
 #include "mapping/slam/graph_log.h"
@@ -68,6 +69,17 @@ TEST(TagEvaluationTest, ScoresAcceptedLandmarkDetectionsAgainstTheTruth) {
   EXPECT_EQ(s.wrong_solutions, 1u);
   EXPECT_EQ(s.wrong_solutions_claimed, 1u) << "0.01 rad sigma does not cover 40 deg";
   EXPECT_NEAR(s.position_error_pct_median, 0.0, 1e-9);  // of 0, 1.3 and 0 %
+  // The wrong one is listed, and the report names it.
+  ASSERT_EQ(s.wrong.size(), 1u);
+  EXPECT_EQ(s.wrong[0].id, 2);
+  EXPECT_NEAR(s.wrong[0].rotation_error_deg, 40.0, 1e-6);
+  EXPECT_NEAR(s.wrong[0].rotation_nees, std::pow(40.0 * M_PI / 180.0 / 0.01, 2), 1e-3);
+  std::ostringstream report;
+  ReportTagScore(s, report);
+  EXPECT_NE(report.str().find("wrong solution: tag 2 at 1.000 s"), std::string::npos)
+      << report.str();
+  EXPECT_NE(report.str().find("rotation off by 40.0 deg"), std::string::npos) << report.str();
+  EXPECT_NE(report.str().find("(claimed)"), std::string::npos) << report.str();
 }
 
 TEST(TagEvaluationTest, AWrongRotationLeftOpenIsNotClaimed) {
