@@ -42,6 +42,8 @@ TagPlacements PlacementsOf(const TagObservation& o, const Eigen::Isometry3d& T_l
 void TagAmbiguityOptions::Validate() const {
   Require(agree_rad > 0.0 && agree_rad < 1.0, "agree_rad", "in (0, 1) rad");
   Require(agree_m > 0.0 && std::isfinite(agree_m), "agree_m", "> 0 m");
+  Require(max_agree_rad >= agree_rad && max_agree_rad < 1.0, "max_agree_rad",
+          "in [agree_rad, 1) rad");
   Require(agree_sigmas >= 0.0 && std::isfinite(agree_sigmas), "agree_sigmas", ">= 0");
   Require(min_support >= 2, "min_support", ">= 2 sightings");
   Require(max_rival_fraction >= 0.0 && max_rival_fraction < 1.0, "max_rival_fraction", "in [0, 1)");
@@ -58,9 +60,11 @@ bool TagAmbiguityResolver::Agree(const TagPlacements& a, std::size_t i, const Ta
   const auto sigma = [](const std::vector<double>& v, std::size_t k) {
     return k < v.size() ? v[k] : 0.0;
   };
-  const double max_rad = std::max(
-      options_.agree_rad, options_.agree_sigmas * std::hypot(sigma(a.rotation_sigma_rad, i),
-                                                             sigma(b.rotation_sigma_rad, j)));
+  const double max_rad =
+      std::min(options_.max_agree_rad,
+               std::max(options_.agree_rad,
+                        options_.agree_sigmas * std::hypot(sigma(a.rotation_sigma_rad, i),
+                                                           sigma(b.rotation_sigma_rad, j))));
   const double max_m =
       std::max(options_.agree_m, options_.agree_sigmas * std::hypot(sigma(a.position_sigma_m, i),
                                                                     sigma(b.position_sigma_m, j)));

@@ -30,6 +30,11 @@ struct TagAmbiguityOptions {
   double agree_rad = 5.0 * 3.14159265358979323846 / 180.0;
   double agree_m = 0.10;
   double agree_sigmas = 2.5;
+  /// ... but never wider in rotation than this [rad]: the two solutions of
+  /// the ambiguity lie 20 degrees or more apart, so a wider tolerance (the
+  /// table's rotation sigma at 4-5 m is several degrees) lets the wrong
+  /// solutions of a few sightings agree with each other or the right one.
+  double max_agree_rad = 10.0 * 3.14159265358979323846 / 180.0;
   /// Sightings that must agree on a placement before it is taken.
   int min_support = 4;
   /// ... and the best rival placement may have at most this fraction of its

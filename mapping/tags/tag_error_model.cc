@@ -37,6 +37,9 @@ void TagErrorModelOptions::Validate() const {
   CheckRange(kName, "corner_delta_px", corner_delta_px, 0.0, 10.0);
   CheckPositive(kName, "sigma_per_max_error", sigma_per_max_error);
   CheckPositive(kName, "corner_sigma_px", corner_sigma_px);
+  CheckPositive(kName, "small_tag_side_px", small_tag_side_px);
+  CheckRange(kName, "flip_sigma_factor", flip_sigma_factor, 1.0, 100.0);
+  CheckRange(kName, "max_tilt_deg", max_tilt_deg, 1.0, 89.0);
   CheckRange(kName, "max_flipped_fraction", max_flipped_fraction, 0.0, 1.0);
   CheckRange(kName, "max_ambiguity_ratio", max_ambiguity_ratio, 0.0, 1.0);
 }
@@ -59,6 +62,23 @@ Matrix6d AnalyticTagCovariance(const Eigen::Isometry3d& T_camera_tag, double tag
   // then leaves a direction unconstrained, so refuse that case upstream by
   // the huge variance it implies instead.
   return information.completeOrthogonalDecomposition().pseudoInverse();
+}
+
+double CornerSigmaPx(const TagErrorModelOptions& options, const Eigen::Isometry3d& T_camera_tag,
+                     double tag_size_m, const calib::RectifiedIntrinsics& camera, int flipped) {
+  const std::array<Eigen::Vector2d, 4> c = ProjectTagCorners(T_camera_tag, tag_size_m, camera);
+  double side_px = 0.0;
+  for (std::size_t k = 0; k < 4; ++k) side_px += (c[(k + 1) % 4] - c[k]).norm() / 4.0;
+  // Foreshortening shortens two edges and spreads each edge's pixels over a
+  // wider blur: the corners lose accuracy about as 1/cos(tilt).
+  const double cos_tilt =
+      std::max(std::cos(TagTilt(T_camera_tag)), std::cos(options.max_tilt_deg * M_PI / 180.0));
+  double sigma = options.corner_sigma_px / cos_tilt;
+  if (side_px < options.small_tag_side_px) {
+    sigma *= std::pow(options.small_tag_side_px / std::max(side_px, 1.0), 0.75);
+  }
+  if (flipped > 0) sigma *= options.flip_sigma_factor;
+  return sigma;
 }
 
 TagErrorModel::TagErrorModel(const TagErrorModelOptions& options,
@@ -88,14 +108,20 @@ TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& cor
   }
   u.refusal = why.str();
   u.ambiguous = u.perturbation.solved > 0 && !u.refusal.empty();
+  if (u.refusal.empty() && std::abs(pose.tilt_rad) > options_.max_tilt_deg * M_PI / 180.0) {
+    why << "seen nearly edge-on: tilt " << std::abs(pose.tilt_rad) * 180.0 / M_PI
+        << " deg (at most " << options_.max_tilt_deg << ")";
+    u.refusal = why.str();
+  }
   if (!u.refusal.empty()) return u;
   if (options_.kind == TagErrorModelKind::kTable) {
     const TagPoseErrors base = table_->Lookup(pose.distance_m, pose.tilt_rad);
     u.sigma = options_.sigma_per_max_error * base.cwiseMax(u.perturbation.max_deviation);
     u.covariance = LineOfSightCovariance(u.sigma, pose.best.T_camera_tag.translation());
   } else {
-    u.covariance =
-        AnalyticTagCovariance(pose.best.T_camera_tag, tag_size_m, camera, options_.corner_sigma_px);
+    const double sigma_px =
+        CornerSigmaPx(options_, pose.best.T_camera_tag, tag_size_m, camera, u.perturbation.flipped);
+    u.covariance = AnalyticTagCovariance(pose.best.T_camera_tag, tag_size_m, camera, sigma_px);
     u.sigma = u.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   }
   if (!u.covariance.allFinite() || !(u.sigma.array() > 0.0).all()) {
@@ -129,8 +155,10 @@ TagUncertainty TagErrorModel::ForSolution(const Eigen::Isometry3d& T_camera_tag,
     u.sigma = options_.sigma_per_max_error * max_error;
     u.covariance = LineOfSightCovariance(u.sigma, T_camera_tag.translation());
   } else {
-    u.covariance =
-        AnalyticTagCovariance(T_camera_tag, tag_size_m, camera, options_.corner_sigma_px);
+    // Chosen between two solutions: as close to the ambiguity as a flipping
+    // detection, whatever the perturbation counted.
+    const double sigma_px = CornerSigmaPx(options_, T_camera_tag, tag_size_m, camera, 1);
+    u.covariance = AnalyticTagCovariance(T_camera_tag, tag_size_m, camera, sigma_px);
     u.sigma = u.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   }
   if (!u.covariance.allFinite() || !(u.sigma.array() > 0.0).all()) {

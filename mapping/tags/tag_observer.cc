@@ -63,6 +63,10 @@ TagObserverOptions TagObserverOptions::Load(const ConfigNode& node) {
   o.model.corner_delta_px = node.Get<double>("corner_delta_px", o.model.corner_delta_px);
   o.model.sigma_per_max_error =
       node.Get<double>("sigma_per_max_error", o.model.sigma_per_max_error);
+  o.model.corner_sigma_px = node.Get<double>("corner_sigma_px", o.model.corner_sigma_px);
+  o.model.small_tag_side_px = node.Get<double>("small_tag_side_px", o.model.small_tag_side_px);
+  o.model.flip_sigma_factor = node.Get<double>("flip_sigma_factor", o.model.flip_sigma_factor);
+  o.model.max_tilt_deg = node.Get<double>("max_tilt_deg", o.model.max_tilt_deg);
   o.model.max_flipped_fraction =
       node.Get<double>("max_flipped_fraction", o.model.max_flipped_fraction);
   o.model.max_ambiguity_ratio =

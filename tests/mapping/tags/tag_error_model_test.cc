@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 #include "mapping/tags/tag_detector.h"
 #include "mapping/tags/tag_image_renderer.h"
@@ -26,6 +29,14 @@ TagErrorTableSpec CoarseSpec() {
   spec.distance_steps = 14;
   spec.tilt_steps = 15;
   return spec;
+}
+
+TagErrorModelOptions TableOptions() { return TagErrorModelOptions{}; }
+
+TagErrorModelOptions AnalyticOptions() {
+  TagErrorModelOptions o;
+  o.kind = TagErrorModelKind::kAnalytic;
+  return o;
 }
 
 const TagErrorTable& Table() {
@@ -78,7 +89,7 @@ TEST(TagErrorModelTest, AnalyticCovarianceMatchesTheSpreadOfNoisyPoses) {
 
 TEST(TagErrorModelTest, TheTableModelTakesTheLargerOfTableAndSpread) {
   const calib::RectifiedIntrinsics camera = TestCamera();
-  const TagErrorModel model(TagErrorModelOptions{}, Table());
+  const TagErrorModel model(TableOptions(), Table());
   const auto corners = ProjectTagCorners(TagAt(1.2, 0.5, 0.1), kTagSizeM, camera);
   std::string error;
   const auto pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
@@ -118,7 +129,7 @@ TEST(TagErrorModelTest, ALineOfSightFrameIsARotationAlongTheLineOfSight) {
 
 TEST(TagErrorModelTest, AnInflatedUncertaintyCoversBothSolutions) {
   const calib::RectifiedIntrinsics camera = TestCamera();
-  const TagErrorModel model(TagErrorModelOptions{}, Table());
+  const TagErrorModel model(TableOptions(), Table());
   // Small and far, nearly head-on: the two solutions are far apart in
   // rotation and close in position.
   const auto corners = ProjectTagCorners(TagAt(4.5, 0.2, 0.1), kTagSizeM, camera);
@@ -141,14 +152,60 @@ TEST(TagErrorModelTest, AnInflatedUncertaintyCoversBothSolutions) {
 
 TEST(TagErrorModelTest, AnUnstablePoseIsRefusedAsAmbiguous) {
   const calib::RectifiedIntrinsics camera = TestCamera();
-  const TagErrorModel model(TagErrorModelOptions{}, Table());
-  const auto corners = ProjectTagCorners(TagAt(6.0, 0.05), kTagSizeM, camera);
+  for (const TagErrorModelOptions& options : {TableOptions(), AnalyticOptions()}) {
+    const TagErrorModel model(options, Table());
+    const auto corners = ProjectTagCorners(TagAt(6.0, 0.05), kTagSizeM, camera);
+    std::string error;
+    const auto pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
+    ASSERT_TRUE(pose.has_value()) << error;
+    const TagUncertainty u = model.Evaluate(corners, *pose, kTagSizeM, camera);
+    EXPECT_FALSE(u.accepted);
+    EXPECT_TRUE(u.ambiguous);
+    EXPECT_NE(u.refusal.find("ambiguous"), std::string::npos) << u.refusal;
+  }
+}
+
+TEST(TagErrorModelTest, ATagSeenNearlyEdgeOnIsRefusedWithItsTilt) {
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const TagErrorModel model(AnalyticOptions(), std::nullopt);
+  const auto corners = ProjectTagCorners(TagAt(1.0, 78.0 * M_PI / 180.0), kTagSizeM, camera);
   std::string error;
   const auto pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
   ASSERT_TRUE(pose.has_value()) << error;
   const TagUncertainty u = model.Evaluate(corners, *pose, kTagSizeM, camera);
   EXPECT_FALSE(u.accepted);
-  EXPECT_NE(u.refusal.find("ambiguous"), std::string::npos) << u.refusal;
+  EXPECT_FALSE(u.ambiguous) << "no other sighting can help";
+  EXPECT_NE(u.refusal.find("edge-on: tilt 78"), std::string::npos) << u.refusal;
+  EXPECT_NE(u.refusal.find("at most 75"), std::string::npos) << u.refusal;
+}
+
+TEST(TagErrorModelTest, TheCornerNoiseGrowsObliquelySmallAndNearTheAmbiguity) {
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const TagErrorModelOptions o = AnalyticOptions();
+  // Head-on and large (about 100 px across at 1 m): the options' noise.
+  EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, 0.0), kTagSizeM, camera, 0), o.corner_sigma_px, 1e-9);
+  // 60 degrees: twice as much.
+  EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, M_PI / 3.0), kTagSizeM, camera, 0),
+              2.0 * o.corner_sigma_px, 1e-6);
+  // A flipping detection: by the flip factor.
+  EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, 0.0), kTagSizeM, camera, 3),
+              o.flip_sigma_factor * o.corner_sigma_px, 1e-9);
+  // Half the reference side: 2^0.75 as much.
+  const auto c = ProjectTagCorners(TagAt(1.0, 0.0), kTagSizeM, camera);
+  const double side_at_1m_px = (c[1] - c[0]).norm();
+  const double distance_m = 2.0 * side_at_1m_px / o.small_tag_side_px;
+  EXPECT_NEAR(CornerSigmaPx(o, TagAt(distance_m, 0.0), kTagSizeM, camera, 0),
+              std::pow(2.0, 0.75) * o.corner_sigma_px, 1e-3 * o.corner_sigma_px);
+  // The analytic covariance follows it: four times the variance at 60
+  // degrees as with the head-on noise.
+  const TagErrorModel model(o, std::nullopt);
+  const Eigen::Isometry3d T = TagAt(1.0, M_PI / 3.0);
+  const TagUncertainty u = model.ForSolution(T, kTagSizeM, camera);
+  ASSERT_TRUE(u.accepted);
+  const Matrix6d head_on_noise = AnalyticTagCovariance(T, kTagSizeM, camera, o.corner_sigma_px);
+  EXPECT_TRUE(
+      u.covariance.isApprox(4.0 * o.flip_sigma_factor * o.flip_sigma_factor * head_on_noise, 1e-6))
+      << "a solution chosen between two counts as flipping";
 }
 
 TEST(TagErrorModelTest, CoversTheTrueErrorOfRenderedDetections) {
@@ -157,7 +214,8 @@ TEST(TagErrorModelTest, CoversTheTrueErrorOfRenderedDetections) {
   // chi^2(6) 95 % bound for at least 90 % of them, and no pose on the wrong
   // side of the ambiguity is accepted.
   const calib::RectifiedIntrinsics camera = TestCamera();
-  const TagErrorModel model(TagErrorModelOptions{}, Table());
+  const TagErrorModel model(TableOptions(), Table());
+  std::vector<double> nees;
   TagDetector detector(TagDetectorOptions{});
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -182,16 +240,27 @@ TEST(TagErrorModelTest, CoversTheTrueErrorOfRenderedDetections) {
     ++accepted;
     const TagPoseErrors e = TagPoseError(pose->best.T_camera_tag, T);
     wrong_accepted += e.tail<3>().norm() > 20.0 * M_PI / 180.0;
-    in_bound += e.dot(u.covariance.ldlt().solve(e)) <= kChi2Six95;
+    nees.push_back(e.dot(u.covariance.ldlt().solve(e)));
+    in_bound += nees.back() <= kChi2Six95;
   }
   EXPECT_GT(accepted, 40);
   EXPECT_GE(in_bound, 0.9 * accepted) << in_bound << " of " << accepted;
   EXPECT_EQ(wrong_accepted, 0);
+  std::nth_element(nees.begin(), nees.begin() + static_cast<std::ptrdiff_t>(nees.size() / 2),
+                   nees.end());
+  const double median = nees[nees.size() / 2];
+  EXPECT_LT(median, 5.3) << "not overconfident";
 }
 
 TEST(TagErrorModelTest, OptionsAreChecked) {
-  EXPECT_THROW(TagErrorModel(TagErrorModelOptions{}, std::nullopt), std::invalid_argument);
+  EXPECT_THROW(TagErrorModel(TableOptions(), std::nullopt), std::invalid_argument);
   TagErrorModelOptions o;
+  o.max_tilt_deg = 90.0;
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+  o = TagErrorModelOptions{};
+  o.flip_sigma_factor = 0.5;
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+  o = TagErrorModelOptions{};
   o.sigma_per_max_error = 0.0;
   EXPECT_THROW(o.Validate(), std::invalid_argument);
   o = TagErrorModelOptions{};
