@@ -134,6 +134,9 @@ void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch, bool 
       problems.push_back(std::string("graph update failed: ") + e.what());
     }
   }
+  if (ok && !snap.summary.covariance_error.empty()) {
+    problems.push_back("graph update: " + snap.summary.covariance_error);
+  }
   if (ok && snap.summary.unanchored.size() != unanchored_reported_) {
     unanchored_reported_ = snap.summary.unanchored.size();
     if (unanchored_reported_ > 0) {

@@ -523,11 +523,18 @@ class RoverGraph::Impl {
     last_cost_ = summary.final_cost;
     out.variables = static_cast<int>(variables_.size());
     out.factors = static_cast<int>(factors_.size());
-    origin_covariance_.clear();
     if (options_.compute_origin_covariances) {
       const Clock::time_point cov_start = Clock::now();
-      ComputeOriginCovariances();
+      // A failure here must not leave the incremental solver behind the
+      // solve below: that state diverged in a mission (hundreds of metres).
+      try {
+        ComputeOriginCovariances();
+      } catch (const GraphError& e) {
+        out.covariance_error = e.what();
+      }
       out.covariance_time_s = Seconds(cov_start);
+    } else {
+      origin_covariance_.clear();
     }
     if (solver_) {
       // The incremental solver continues from this optimum.
@@ -566,7 +573,9 @@ class RoverGraph::Impl {
       }
     }
     if (!covariance.Compute(blocks, problem_.get())) {
-      throw GraphError("origin covariances: the problem is rank deficient (gauge problem?)");
+      throw GraphError(
+          "origin covariances: the problem is rank deficient (gauge problem?); the last ones "
+          "are kept");
     }
     for (const auto& [key, v] : variables_) {
       if (key.type != GraphKey::Type::kOrigin || !v.in_problem) continue;

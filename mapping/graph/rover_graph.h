@@ -136,6 +136,10 @@ struct RoverGraphSummary {
   /// a chain broken by a refused factor): left out of the solve, with their
   /// factors, until a factor connects them.
   std::vector<GraphKey> unanchored;
+  /// Why the origins' marginals could not be computed this time (e.g. a
+  /// rank-deficient problem); empty if they were. The solve stands, and the
+  /// previous marginals are kept.
+  std::string covariance_error;
 };
 
 class RoverGraph {

@@ -485,6 +485,40 @@ TEST(RoverGraphTest, UnanchoredComponentWaitsOutsideTheSolve) {
   EXPECT_LT((g.Origin(1, 1).translation() - Eigen::Vector3d(1.0, 2.0, 0.0)).norm(), 1e-6);
 }
 
+// A landmark whose rotation nothing constrains (every sighting's rotation
+// left open) makes the marginals rank deficient. The solve stands, the last
+// marginals are kept, the summary says why, and later updates go on from the
+// solve (a solver left behind it diverged in a mission).
+TEST(RoverGraphTest, MarginalsThatCannotBeComputedKeepTheSolveAndTheLastOnes) {
+  RoverGraphOptions options;
+  options.incremental_solve = false;  // the full solve computes the marginals with Ceres
+  RoverGraph g(options);
+  g.AddOriginPrior(0, Eigen::Isometry3d::Identity(), Diagonal(1e-8, 1e-8, 1e-8));
+  const Eigen::Isometry3d T_local_body = MakePose({2.0, 0.0, 0.0}, Rz(0.1));
+  g.AddFilterPose(0, 0, 1, T_local_body, Diagonal(1e-4, 1e-6, 1e-6));
+  ASSERT_TRUE(g.Optimize().covariance_error.empty());
+  const Matrix6d before = g.OriginCovariance(0, 0);
+  Matrix6d open_rotation = Diagonal(1e-4, 1e-4, 1e-4);
+  open_rotation.bottomRightCorner<3, 3>() *= 1e30;
+  // Twice: a loop, so the update solves instead of only extending the graph.
+  g.AddLandmarkObservation(0, 1, 5, MakePose({3.0, 1.0, 0.0}, Rz(0.3)), open_rotation);
+  g.AddLandmarkObservation(0, 1, 5, MakePose({3.0, 1.0, 0.0}, Rz(0.3)), open_rotation);
+  RoverGraphSummary summary;
+  ASSERT_NO_THROW(summary = g.Optimize());
+  EXPECT_TRUE(summary.solved);
+  EXPECT_NE(summary.covariance_error.find("rank deficient"), std::string::npos)
+      << summary.covariance_error;
+  EXPECT_TRUE(g.OriginCovariance(0, 0).isApprox(before));
+  g.AddFrameSwitch(0, 0, MakePose({1.0, 0.0, 0.0}, Rz(0.0)), Matrix4d::Identity() * 1e-6);
+  g.AddFilterPose(0, 1, 2, T_local_body, Diagonal(1e-4, 1e-6, 1e-6));
+  g.Optimize();
+  EXPECT_LT((g.Origin(0, 1).translation() - Eigen::Vector3d(1.0, 0.0, 0.0)).norm(), 1e-6);
+  EXPECT_LT((g.Estimate(GraphKey::Landmark(5)).translation() -
+             (T_local_body * MakePose({3.0, 1.0, 0.0}, Rz(0.3))).translation())
+                .norm(),
+            1e-6);
+}
+
 TEST(RoverGraphTest, NanInputIsRejected) {
   RoverGraph g;
   Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
