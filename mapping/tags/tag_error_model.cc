@@ -40,6 +40,7 @@ void TagErrorModelOptions::Validate() const {
   CheckPositive(kName, "small_tag_side_px", small_tag_side_px);
   CheckRange(kName, "flip_sigma_factor", flip_sigma_factor, 1.0, 100.0);
   CheckRange(kName, "max_tilt_deg", max_tilt_deg, 1.0, 89.0);
+  CheckPositive(kName, "max_reprojection_rmse_px", max_reprojection_rmse_px);
   CheckRange(kName, "max_flipped_fraction", max_flipped_fraction, 0.0, 1.0);
   CheckRange(kName, "max_ambiguity_ratio", max_ambiguity_ratio, 0.0, 1.0);
 }
@@ -99,20 +100,23 @@ TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& cor
   const double flipped = u.perturbation.flipped / 256.0;
   if (u.perturbation.solved == 0) {
     why << "no pose for the detected corners";
+  } else if (pose.best.reprojection_rmse_px > options_.max_reprojection_rmse_px) {
+    why << "the corners do not fit a square of the tag's size: reprojection RMSE "
+        << pose.best.reprojection_rmse_px << " px (at most " << options_.max_reprojection_rmse_px
+        << "), a corner misplaced";
+  } else if (std::abs(pose.tilt_rad) > options_.max_tilt_deg * M_PI / 180.0) {
+    why << "seen nearly edge-on: tilt " << std::abs(pose.tilt_rad) * 180.0 / M_PI
+        << " deg (at most " << options_.max_tilt_deg << ")";
   } else if (flipped > options_.max_flipped_fraction) {
     why << "ambiguous: " << u.perturbation.flipped << " of 256 perturbed poses flip to the other "
         << "solution";
+    u.ambiguous = true;
   } else if (pose.ambiguity_ratio > options_.max_ambiguity_ratio) {
     why << "ambiguous: the two solutions fit within a ratio of " << pose.ambiguity_ratio
         << " (at most " << options_.max_ambiguity_ratio << ")";
+    u.ambiguous = true;
   }
   u.refusal = why.str();
-  u.ambiguous = u.perturbation.solved > 0 && !u.refusal.empty();
-  if (u.refusal.empty() && std::abs(pose.tilt_rad) > options_.max_tilt_deg * M_PI / 180.0) {
-    why << "seen nearly edge-on: tilt " << std::abs(pose.tilt_rad) * 180.0 / M_PI
-        << " deg (at most " << options_.max_tilt_deg << ")";
-    u.refusal = why.str();
-  }
   if (!u.refusal.empty()) return u;
   if (options_.kind == TagErrorModelKind::kTable) {
     const TagPoseErrors base = table_->Lookup(pose.distance_m, pose.tilt_rad);

@@ -67,6 +67,8 @@ TagObserverOptions TagObserverOptions::Load(const ConfigNode& node) {
   o.model.small_tag_side_px = node.Get<double>("small_tag_side_px", o.model.small_tag_side_px);
   o.model.flip_sigma_factor = node.Get<double>("flip_sigma_factor", o.model.flip_sigma_factor);
   o.model.max_tilt_deg = node.Get<double>("max_tilt_deg", o.model.max_tilt_deg);
+  o.model.max_reprojection_rmse_px =
+      node.Get<double>("max_reprojection_rmse_px", o.model.max_reprojection_rmse_px);
   o.model.max_flipped_fraction =
       node.Get<double>("max_flipped_fraction", o.model.max_flipped_fraction);
   o.model.max_ambiguity_ratio =

@@ -179,6 +179,26 @@ TEST(TagErrorModelTest, ATagSeenNearlyEdgeOnIsRefusedWithItsTilt) {
   EXPECT_NE(u.refusal.find("at most 75"), std::string::npos) << u.refusal;
 }
 
+TEST(TagErrorModelTest, CornersThatAreNotASquareAreRefused) {
+  const calib::RectifiedIntrinsics camera = TestCamera();
+  const TagErrorModel model(TableOptions(), Table());
+  auto corners = ProjectTagCorners(TagAt(1.1, 0.4), kTagSizeM, camera);
+  std::string error;
+  auto pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
+  ASSERT_TRUE(pose.has_value()) << error;
+  EXPECT_TRUE(model.Evaluate(corners, *pose, kTagSizeM, camera).accepted);
+  // One corner 20 px off, as where the image border cuts the tag (10 px
+  // the pose mostly absorbs: 0.65 px RMSE).
+  corners[1].y() -= 20.0;
+  pose = EstimateTagPose(corners, kTagSizeM, camera, &error);
+  ASSERT_TRUE(pose.has_value()) << error;
+  const TagUncertainty u = model.Evaluate(corners, *pose, kTagSizeM, camera);
+  EXPECT_FALSE(u.accepted);
+  EXPECT_FALSE(u.ambiguous);
+  EXPECT_NE(u.refusal.find("do not fit a square"), std::string::npos)
+      << u.refusal << " rmse " << pose->best.reprojection_rmse_px;
+}
+
 TEST(TagErrorModelTest, TheCornerNoiseGrowsObliquelySmallAndNearTheAmbiguity) {
   const calib::RectifiedIntrinsics camera = TestCamera();
   const TagErrorModelOptions o = AnalyticOptions();
