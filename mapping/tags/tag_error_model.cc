@@ -150,6 +150,7 @@ TagUncertainty TagErrorModel::ForSolution(const Eigen::Isometry3d& T_camera_tag,
                                           const calib::RectifiedIntrinsics& camera,
                                           const CornerPerturbation* perturbation) const {
   TagUncertainty u;
+  if (perturbation != nullptr) u.perturbation = *perturbation;  // logged with the detection
   if (options_.kind == TagErrorModelKind::kTable) {
     TagPoseErrors max_error =
         table_->Lookup(T_camera_tag.translation().norm(), TagTilt(T_camera_tag));

@@ -155,6 +155,11 @@ TEST(TagObserverTest, AnAmbiguousDetectionComesWithBothSolutionsCovariancesAndTh
       EXPECT_TRUE(o.solutions[1].accepted);
       EXPECT_TRUE(o.inflated.accepted);
       EXPECT_GE(o.inflated.covariance.trace(), o.solutions[0].covariance.trace());
+      // The detection's perturbation goes with whichever is logged.
+      for (const TagUncertainty* u : {&o.solutions[0], &o.solutions[1], &o.inflated}) {
+        EXPECT_EQ(u->perturbation.flipped, o.uncertainty.perturbation.flipped);
+        EXPECT_EQ(u->perturbation.solved, o.uncertainty.perturbation.solved);
+      }
     }
   }
   EXPECT_GT(ambiguous, 0) << "no ambiguous detection to check";
