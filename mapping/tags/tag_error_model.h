@@ -32,11 +32,12 @@ enum class TagErrorModelKind { kTable, kAnalytic };
 
 struct TagErrorModelOptions {
   /// kTable by default: on bench_tag_model's detections (half of them
-  /// upright, seeds 1-8) it keeps 94-98 % within the chi^2(6) 95 % bound,
-  /// though about 8x too conservative by the median NEES. kAnalytic is
-  /// 2.5-3x too conservative by the median but keeps only 89-93 %: upright
-  /// tags seen head-on, whose edges run along the pixel grid, have corner
-  /// errors larger than its noise and correlated between corners.
+  /// upright, seeds 1-10) it keeps 95.6-99.4 % within the chi^2(6) 95 %
+  /// bound, though 6-10x too conservative by the median NEES (1.1-4.8x by
+  /// the mean). kAnalytic is 1.8-2.5x too conservative by the median (within
+  /// 2x by the mean) but keeps only 85.8-93.1 %: upright tags seen head-on,
+  /// whose edges run along the pixel grid, have corner errors larger than
+  /// its noise and correlated between corners.
   TagErrorModelKind kind = TagErrorModelKind::kTable;
   /// The calibration's pixel error: the online perturbation +-delta [px].
   double corner_delta_px = 0.3;

@@ -63,26 +63,27 @@ TEST(TagAmbiguityResolverTest, WideRotationSigmasDoNotLetTheSwingingSolutionAgre
   // would span the wrong solution's swing of 6 deg per image, so it would
   // gather as much support as the right one and nothing would be decided.
   // The cap at 10 deg keeps the wrong solutions apart.
+  // Eight sightings, each with 8 deg rotation sigmas, the wrong solution
+  // swinging 6 deg per sighting.
+  const auto feed = [](TagAmbiguityResolver* resolver) {
+    std::vector<TagDecision> decisions;
+    for (uint64_t k = 1; k <= 8; ++k) {
+      TagPlacements s =
+          Ambiguous(k, TrueTag(), Wrong((24.0 + 6.0 * static_cast<double>(k)) * kDeg));
+      s.rotation_sigma_rad = {8.0 * kDeg, 8.0 * kDeg};
+      s.position_sigma_m = {0.05, 0.05};
+      for (const TagDecision& d : resolver->Add(s)) decisions.push_back(d);
+    }
+    return decisions;
+  };
   TagAmbiguityResolver resolver;
-  std::vector<TagDecision> decisions;
-  for (uint64_t k = 1; k <= 8; ++k) {
-    TagPlacements s = Ambiguous(k, TrueTag(), Wrong((24.0 + 6.0 * static_cast<double>(k)) * kDeg));
-    s.rotation_sigma_rad = {8.0 * kDeg, 8.0 * kDeg};
-    s.position_sigma_m = {0.05, 0.05};
-    for (const TagDecision& d : resolver.Add(s)) decisions.push_back(d);
-  }
+  const std::vector<TagDecision> decisions = feed(&resolver);
   ASSERT_EQ(decisions.size(), 8u);
   for (const TagDecision& d : decisions) EXPECT_EQ(d.solution, 0) << "sighting " << d.key;
   TagAmbiguityOptions options;
   options.max_agree_rad = 0.9;  // uncapped: 2.5 x hypot(8, 8) deg = 28 deg
   TagAmbiguityResolver uncapped(options);
-  std::vector<TagDecision> uncapped_decisions;
-  for (uint64_t k = 1; k <= 8; ++k) {
-    TagPlacements s = Ambiguous(k, TrueTag(), Wrong((24.0 + 6.0 * static_cast<double>(k)) * kDeg));
-    s.rotation_sigma_rad = {8.0 * kDeg, 8.0 * kDeg};
-    s.position_sigma_m = {0.05, 0.05};
-    for (const TagDecision& d : uncapped.Add(s)) uncapped_decisions.push_back(d);
-  }
+  const std::vector<TagDecision> uncapped_decisions = feed(&uncapped);
   EXPECT_TRUE(uncapped_decisions.empty()) << "the rival has as much support";
   EXPECT_EQ(uncapped.waiting(), 8u);
 }
