@@ -24,6 +24,7 @@ TagDecision Undecided(const TagPlacements& s, std::string why) {
 TagPlacements PlacementsOf(const TagObservation& o, const Eigen::Isometry3d& T_local_cam,
                            uint64_t key, int64_t stamp_ns, uint32_t frame_id) {
   TagPlacements p{.key = key, .stamp_ns = stamp_ns, .tag_id = o.detection.id, .frame_id = frame_id};
+  p.p_local_cam = T_local_cam.translation();
   const auto add = [&](const Eigen::Isometry3d& T_camera_tag, const TagUncertainty& u) {
     p.T_local_tag.push_back(T_local_cam * T_camera_tag);
     p.rotation_sigma_rad.push_back(u.sigma.tail<3>().maxCoeff());
@@ -46,6 +47,8 @@ void TagAmbiguityOptions::Validate() const {
           "in [agree_rad, 1) rad");
   Require(agree_sigmas >= 0.0 && std::isfinite(agree_sigmas), "agree_sigmas", ">= 0");
   Require(min_support >= 2, "min_support", ">= 2 sightings");
+  Require(min_view_change_rad >= 0.0 && min_view_change_rad < 3.2, "min_view_change_rad",
+          "in [0, pi] rad");
   Require(max_rival_fraction >= 0.0 && max_rival_fraction < 1.0, "max_rival_fraction", "in [0, 1)");
   Require(max_wait_s > 0.0 && std::isfinite(max_wait_s), "max_wait_s", "> 0 s");
   Require(max_sightings >= min_support, "max_sightings", ">= min_support");
@@ -154,6 +157,7 @@ void TagAmbiguityResolver::Decide(Group* g, std::vector<TagDecision>* out) const
     }
   }
   if (best_support < options_.min_support) return;
+  if (ViewChange(all, all[best_s], best_i) < options_.min_view_change_rad) return;
   int rival_support = 0;
   for (std::size_t s = 0; s < all.size(); ++s) {
     for (std::size_t i = 0; i < all[s].T_local_tag.size(); ++i) {
@@ -176,6 +180,29 @@ void TagAmbiguityResolver::Decide(Group* g, std::vector<TagDecision>* out) const
     }
     out->push_back(d);
   }
+}
+
+double TagAmbiguityResolver::ViewChange(const std::vector<TagPlacements>& all,
+                                        const TagPlacements& chosen, std::size_t i) const {
+  // The widest angle between two supporting sightings' lines of sight to
+  // the chosen placement.
+  const Eigen::Vector3d p_local_tag = chosen.T_local_tag[i].translation();
+  std::vector<Eigen::Vector3d> rays;
+  for (const TagPlacements& other : all) {
+    for (std::size_t j = 0; j < other.T_local_tag.size(); ++j) {
+      if (!Agree(chosen, i, other, j)) continue;
+      const Eigen::Vector3d ray = p_local_tag - other.p_local_cam;
+      if (ray.norm() > 0.0) rays.push_back(ray.normalized());
+      break;
+    }
+  }
+  double widest = 0.0;
+  for (std::size_t a = 0; a < rays.size(); ++a) {
+    for (std::size_t b = a + 1; b < rays.size(); ++b) {
+      widest = std::max(widest, std::acos(std::clamp(rays[a].dot(rays[b]), -1.0, 1.0)));
+    }
+  }
+  return widest;
 }
 
 std::vector<TagDecision> TagAmbiguityResolver::Expire(int64_t now_ns, bool all) {

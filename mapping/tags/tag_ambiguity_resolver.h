@@ -37,6 +37,12 @@ struct TagAmbiguityOptions {
   double max_agree_rad = 10.0 * 3.14159265358979323846 / 180.0;
   /// Sightings that must agree on a placement before it is taken.
   int min_support = 4;
+  /// ... seen along lines of sight at least this far apart [rad]. Driving
+  /// straight at a tag, its wrong solution (mirrored about the line of
+  /// sight) stays put as the right one does, and agreement says nothing:
+  /// in the landmark missions a tag approached head-on was decided wrong
+  /// twice.
+  double min_view_change_rad = 10.0 * 3.14159265358979323846 / 180.0;
   /// ... and the best rival placement may have at most this fraction of its
   /// support.
   double max_rival_fraction = 0.5;
@@ -63,6 +69,8 @@ struct TagPlacements {
   /// deviation (empty: agree_rad and agree_m alone decide).
   std::vector<double> rotation_sigma_rad{};
   std::vector<double> position_sigma_m{};
+  /// Where the camera was [m, local frame].
+  Eigen::Vector3d p_local_cam = Eigen::Vector3d::Zero();
 };
 
 struct TagDecision {
@@ -108,6 +116,10 @@ class TagAmbiguityResolver {
   void Decide(Group* group, std::vector<TagDecision>* out) const;
   /// Placement i of sighting a against placement j of sighting b.
   bool Agree(const TagPlacements& a, std::size_t i, const TagPlacements& b, std::size_t j) const;
+  /// The widest angle [rad] between the lines of sight of the sightings
+  /// that agree with placement i of `chosen`.
+  double ViewChange(const std::vector<TagPlacements>& all, const TagPlacements& chosen,
+                    std::size_t i) const;
 
   TagAmbiguityOptions options_;
   std::map<std::pair<uint32_t, int>, Group> groups_;  ///< by (frame, tag id)

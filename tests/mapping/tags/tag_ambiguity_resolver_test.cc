@@ -26,13 +26,20 @@ Eigen::Isometry3d Wrong(double angle_rad) {
   return T;
 }
 
+// The camera drives past the tag along x, 1 m per sighting, 6 m to its
+// side: the line of sight turns by 5-10 deg per sighting.
+Eigen::Vector3d CameraAt(uint64_t key) {
+  return Eigen::Vector3d(2.0 + static_cast<double>(key), -8.0, 0.8);
+}
+
 TagPlacements Ambiguous(uint64_t key, const Eigen::Isometry3d& best,
                         const Eigen::Isometry3d& alternative, uint32_t frame = 3) {
   return {.key = key,
           .stamp_ns = static_cast<int64_t>(key) * 500'000'000,
           .tag_id = 7,
           .frame_id = frame,
-          .T_local_tag = {best, alternative}};
+          .T_local_tag = {best, alternative},
+          .p_local_cam = CameraAt(key)};
 }
 
 TEST(TagAmbiguityResolverTest, TheSolutionThatStaysPutWinsOverTheOneThatSwings) {
@@ -86,6 +93,40 @@ TEST(TagAmbiguityResolverTest, WideRotationSigmasDoNotLetTheSwingingSolutionAgre
   const std::vector<TagDecision> uncapped_decisions = feed(&uncapped);
   EXPECT_TRUE(uncapped_decisions.empty()) << "the rival has as much support";
   EXPECT_EQ(uncapped.waiting(), 8u);
+}
+
+TEST(TagAmbiguityResolverTest, SightingsAlongOneLineOfSightDecideNothing) {
+  // Driving straight at the tag, the wrong solution stays put as the right
+  // one does, so agreement cannot tell them apart. Here the right one is
+  // noisier (6 deg apart from sighting to sighting) and the wrong one
+  // gathers all the support: without the view change it would be taken.
+  TagAmbiguityResolver resolver;
+  const Eigen::Vector3d towards_tag = (TrueTag().translation() - CameraAt(0)).normalized();
+  for (uint64_t k = 1; k <= 8; ++k) {
+    Eigen::Isometry3d noisy = TrueTag();
+    noisy.linear() =
+        noisy.linear() *
+        Eigen::AngleAxisd(6.0 * static_cast<double>(k) * kDeg, Eigen::Vector3d::UnitZ()).matrix();
+    TagPlacements s = Ambiguous(k, Wrong(40.0 * kDeg), noisy);
+    s.p_local_cam = CameraAt(0) + 0.5 * static_cast<double>(k) * towards_tag;
+    EXPECT_TRUE(resolver.Add(s).empty()) << "sighting " << k;
+  }
+  EXPECT_EQ(resolver.waiting(), 8u);
+  TagAmbiguityOptions blind;
+  blind.min_view_change_rad = 0.0;
+  TagAmbiguityResolver without_view_change(blind);
+  std::vector<TagDecision> wrong;
+  for (uint64_t k = 1; k <= 8; ++k) {
+    Eigen::Isometry3d noisy = TrueTag();
+    noisy.linear() =
+        noisy.linear() *
+        Eigen::AngleAxisd(6.0 * static_cast<double>(k) * kDeg, Eigen::Vector3d::UnitZ()).matrix();
+    TagPlacements s = Ambiguous(k, Wrong(40.0 * kDeg), noisy);
+    s.p_local_cam = CameraAt(0) + 0.5 * static_cast<double>(k) * towards_tag;
+    for (const TagDecision& d : without_view_change.Add(s)) wrong.push_back(d);
+  }
+  ASSERT_FALSE(wrong.empty()) << "the case the view change guards against";
+  EXPECT_EQ(wrong[0].solution, 0) << "the wrong solution";
 }
 
 TEST(TagAmbiguityResolverTest, TwoStillSolutionsAreNeverDecided) {
