@@ -554,6 +554,10 @@ void IncrementalPoseSolver::Estimate(int v, double* x) const {
   impl_->manifold_.Plus(var.theta.data(), var.delta.data(), x);
 }
 
+void IncrementalPoseSolver::ScaleStep(double alpha) {
+  for (Impl::Variable& var : impl_->variables_) var.delta *= alpha;
+}
+
 void IncrementalPoseSolver::ResetLinearization(const std::vector<const double*>& x_of) {
   Impl& m = *impl_;
   for (size_t v = 0; v < m.variables_.size(); ++v) {

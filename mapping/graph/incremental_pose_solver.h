@@ -103,6 +103,11 @@ class IncrementalPoseSolver {
   /// Current estimate theta (+) delta of variable v into x (7 doubles).
   void Estimate(int v, double* x) const;
 
+  /// Scales every variable's pending step delta by alpha (a backtracking
+  /// line search by the caller, who knows the true cost): the estimate
+  /// becomes theta (+) alpha delta, and the next Update() carries on from it.
+  void ScaleStep(double alpha);
+
   /// Resets every linearisation point to x_of[v] (e.g. after an external
   /// solve): all factors are relinearised and the graph re-ordered at the
   /// next Update().

@@ -5,7 +5,10 @@
 #include <Eigen/Cholesky>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <deque>
+#include <limits>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -349,17 +352,24 @@ class RoverGraph::Impl {
   // on an update that only extends the graph, which otherwise costs nothing,
   // instead of on the next loop closure, whose own work it would add to.
   void ReorderSolver(RoverGraphSummary* out) {
+    const CostedEstimate before = CurrentEstimate();
     try {
       const IncrementalPoseSolverStats stats = solver_->Update();
       out->refactored_columns = stats.refactored_columns;
       out->reordered = stats.reordered;
-      refine_due_ = !stats.converged;
+      bool shortened = false;
       refine_steps_ = 0;
-      CopySolverEstimates();
+      refine_due_ = true;
+      if (CostIfLower(before, &shortened)) {
+        refine_due_ = !stats.converged || shortened;
+        return;
+      }
     } catch (const std::runtime_error&) {
-      // Singular: start the solver over; the next loop closure decides.
-      ResetSolver();
     }
+    // Singular, or a step that raised the cost: start the solver over from
+    // the estimate as it was; the next loop closure decides.
+    refine_due_ = false;
+    ResetSolver();
   }
 
   void CopySolverEstimates() {
@@ -406,6 +416,7 @@ class RoverGraph::Impl {
     AddPendingToProblem();
     const std::vector<int> seeds = AddPendingToSolver();
     const Clock::time_point start = Clock::now();
+    const CostedEstimate before = CurrentEstimate();
     IncrementalPoseSolverStats stats;
     try {
       stats = solver_->Update();
@@ -415,9 +426,12 @@ class RoverGraph::Impl {
     // Converging updates that do not converge fall back to Ceres; with a
     // fixed number of steps the next updates carry on from here.
     if (!stats.converged && options_.incremental_steps == 0) return Solve(out);
-    refine_due_ = !stats.converged;
+    bool shortened = false;
+    const std::optional<double> cost = CostIfLower(before, &shortened);
+    if (!cost) return Solve(out);
+    refine_due_ = !stats.converged || shortened;
     refine_steps_ = 0;
-    AcceptIncrementalStep(stats, solver_->LinearizedCost(), start, &out);
+    AcceptIncrementalStep(stats, *cost, start, &out);
     out.reordered = stats.reordered;
     out.variables = static_cast<int>(variables_.size());
     out.factors = static_cast<int>(factors_.size());
@@ -459,6 +473,7 @@ class RoverGraph::Impl {
       return out;
     }
     const Clock::time_point start = Clock::now();
+    const CostedEstimate before = CurrentEstimate();
     IncrementalPoseSolverStats stats;
     try {
       stats = solver_->Update();
@@ -467,29 +482,81 @@ class RoverGraph::Impl {
       return Solve(out);
     }
     ++refine_steps_;
-    refine_due_ = !stats.converged;
-    const double cost = solver_->LinearizedCost();
-    if (refine_due_ && (refine_steps_ >= MaxRefineSteps() || cost > last_cost_ * 1.001)) {
+    bool shortened = false;
+    const std::optional<double> cost = CostIfLower(before, &shortened);
+    refine_due_ = !stats.converged || shortened;
+    if (!cost || (refine_due_ && refine_steps_ >= MaxRefineSteps())) {
       // As a converging update does: what undamped Gauss-Newton does not
       // settle (a robust factor's weight swinging after a large correction
       // raises the cost, or the steps never end), Ceres's trust region does,
       // and the swinging estimate is never published.
       return Solve(out);
     }
-    AcceptIncrementalStep(stats, cost, start, &out);
+    AcceptIncrementalStep(stats, *cost, start, &out);
     return out;
   }
+
+  // The variables' values and the true cost 1/2 sum rho(|r|^2) there.
+  struct CostedEstimate {
+    std::vector<std::array<double, 7>> x;  // by solver index
+    double cost = 0.0;
+  };
+
+  CostedEstimate CurrentEstimate() const {
+    CostedEstimate e;
+    e.x.reserve(solver_variables_.size());
+    for (const Variable* v : solver_variables_) e.x.push_back(v->x);
+    e.cost = ProblemCost();
+    return e;
+  }
+
+  double ProblemCost() const {
+    double cost = 0.0;
+    if (!problem_->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr)) {
+      return std::numeric_limits<double>::infinity();
+    }
+    return cost;
+  }
+
+  // Takes the incremental solver's estimate if it lowers the true cost, and
+  // returns that cost; otherwise halves the step (a backtracking line search)
+  // up to kMaxStepHalvings times, and failing that puts `before` back and
+  // returns nothing (the caller hands the graph to Ceres). An undamped
+  // Gauss-Newton step with the exact robust curvature is only as good as its
+  // quadratic model: a loop closure's full step often overshoots, and a new
+  // sighting contradicting a landmark's earlier ones left the curvature
+  // along its residual nearly zero, so that one step threw a variable 4e8 m
+  // away, into the flat tail of the Cauchy loss where no solver brings it
+  // back. *shortened: the step taken is a fraction of the full one.
+  std::optional<double> CostIfLower(const CostedEstimate& before, bool* shortened = nullptr) {
+    for (int halvings = 0; halvings <= kMaxStepHalvings; ++halvings) {
+      CopySolverEstimates();
+      const double cost = ProblemCost();
+      if (std::isfinite(cost) && cost <= before.cost * (1.0 + kCostTolerance)) {
+        if (shortened != nullptr) *shortened = halvings > 0;
+        return cost;
+      }
+      solver_->ScaleStep(0.5);
+    }
+    for (size_t i = 0; i < solver_variables_.size(); ++i) solver_variables_[i]->x = before.x[i];
+    return std::nullopt;
+  }
+
+  // A step that leaves the cost within this fraction of where it was stands:
+  // at convergence the cost changes by rounding alone.
+  static constexpr double kCostTolerance = 1e-9;
+  // Down to 1/64 of the Gauss-Newton step before Ceres takes over.
+  static constexpr int kMaxStepHalvings = 6;
 
   // An incremental step that stands: its estimates become the graph's, and
   // the summary says what it did.
   void AcceptIncrementalStep(const IncrementalPoseSolverStats& stats, double cost,
                              Clock::time_point start, RoverGraphSummary* out) {
-    CopySolverEstimates();
     out->solve_time_s = Seconds(start);
     out->iterations = stats.iterations;
     out->initial_cost = last_cost_;
     out->final_cost = last_cost_ = cost;
-    out->converged = stats.converged;
+    out->converged = stats.converged && !refine_due_;
     out->solved = true;
     out->incremental_solve = true;
     out->relinearized = stats.relinearized_variables;

@@ -519,6 +519,36 @@ TEST(RoverGraphTest, MarginalsThatCannotBeComputedKeepTheSolveAndTheLastOnes) {
             1e-6);
 }
 
+// A landmark held only by a weak sighting, then seen by a strong one at the
+// Cauchy scale (2 sigma): there the strong sighting's exact robust curvature
+// along its residual is zero, and the one undamped Gauss-Newton step of an
+// online update throws the landmark about a million metres away. The graph
+// must not take a step that raises the cost: Ceres settles the update.
+TEST(RoverGraphTest, AnIncrementalStepThatRaisesTheCostIsNotTaken) {
+  RoverGraph g(RoverGraphOptions::Online());
+  const double c = RoverGraphOptions::Online().cauchy_scale;
+  g.AddOriginPrior(0, Eigen::Isometry3d::Identity(), Diagonal(1e-8, 1e-8, 1e-8));
+  const Eigen::Isometry3d T_local_body = MakePose({2.0, 0.0, 0.0}, Rz(0.0));
+  g.AddFilterPose(0, 0, 1, T_local_body, Diagonal(1e-8, 1e-8, 1e-8));
+  g.AddFilterPose(0, 0, 2, T_local_body, Diagonal(1e-8, 1e-8, 1e-8));
+  const Eigen::Isometry3d T_body_landmark = MakePose({3.0, 0.0, 0.0}, Rz(0.0));
+  const double weak_sigma_m = 100.0, strong_sigma_m = 0.01;
+  g.AddLandmarkObservation(0, 1, 5, T_body_landmark,
+                           Diagonal(weak_sigma_m * weak_sigma_m, 1e-4, 1e-4));
+  ASSERT_TRUE(g.Optimize().solved);
+  Eigen::Isometry3d strong = T_body_landmark;
+  strong.translation().x() += c * strong_sigma_m;
+  g.AddLandmarkObservation(0, 2, 5, strong, Diagonal(strong_sigma_m * strong_sigma_m, 1e-4, 1e-4));
+  const RoverGraphSummary summary = g.Optimize();
+  EXPECT_TRUE(summary.solved);
+  EXPECT_FALSE(summary.incremental_solve);
+  EXPECT_LT(summary.final_cost, summary.initial_cost + 2.0);
+  const Eigen::Vector3d p_landmark = g.Estimate(GraphKey::Landmark(5)).translation();
+  EXPECT_LT((p_landmark - (T_local_body * strong).translation()).norm(), 0.05) << p_landmark;
+  while (g.NeedsRefinement()) g.Refine();
+  EXPECT_LT((g.Estimate(GraphKey::Landmark(5)).translation() - p_landmark).norm(), 0.05);
+}
+
 TEST(RoverGraphTest, NanInputIsRejected) {
   RoverGraph g;
   Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
