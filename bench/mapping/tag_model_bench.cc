@@ -14,6 +14,12 @@
 //   bench_tag_model [--samples N] [--seed S] [--table-steps N] [--delta-px X]
 //                   [--corner-sigma-px X] [--sigma-per-max X] [--max-flipped F]
 //                   [--max-ambiguity R] [--decimate D] [--csv PATH]
+//                   [--tilt-exponent X] [--frontal-gain X] [--edge-sigma-px X]
+//                   [--upright-roll-deg X]
+//
+// --upright-roll-deg: the upright half's roll spread (default 5 degrees; 0:
+// edges exactly along the pixel rows and columns, as a level rover sees a
+// post's tag).
 //
 // --csv writes one row per accepted detection and model: the truth's
 // distance and tilt, the rendering, the error in the line-of-sight frame,
@@ -61,6 +67,10 @@ struct Args {
   double max_flipped = TagErrorModelOptions{}.max_flipped_fraction;
   double max_ambiguity = TagErrorModelOptions{}.max_ambiguity_ratio;
   double decimate = TagDetectorOptions{}.quad_decimate;
+  double tilt_exponent = TagErrorModelOptions{}.tilt_sigma_exponent;
+  double frontal_gain = TagErrorModelOptions{}.frontal_sigma_gain;
+  double edge_sigma_px = TagErrorModelOptions{}.aligned_edge_sigma_px;
+  double upright_roll_deg = 5.0;
   std::string csv_path;
 };
 
@@ -95,6 +105,14 @@ Args Parse(int argc, char** argv) {
       a.decimate = std::atof(next());
     else if (s == "--csv")
       a.csv_path = next();
+    else if (s == "--tilt-exponent")
+      a.tilt_exponent = std::atof(next());
+    else if (s == "--frontal-gain")
+      a.frontal_gain = std::atof(next());
+    else if (s == "--edge-sigma-px")
+      a.edge_sigma_px = std::atof(next());
+    else if (s == "--upright-roll-deg")
+      a.upright_roll_deg = std::atof(next());
     else {
       std::fprintf(stderr, "unknown argument %s (see the comment at the top of the source)\n",
                    s.c_str());
@@ -146,6 +164,9 @@ int Run(int argc, char** argv) {
   TagErrorModelOptions analytic_options = table_options;
   analytic_options.kind = TagErrorModelKind::kAnalytic;
   analytic_options.corner_sigma_px = args.corner_sigma_px;
+  analytic_options.tilt_sigma_exponent = args.tilt_exponent;
+  analytic_options.frontal_sigma_gain = args.frontal_gain;
+  analytic_options.aligned_edge_sigma_px = args.edge_sigma_px;
   const TagErrorModel analytic_model(analytic_options, std::nullopt);
 
   TagDetectorOptions detector_options;
@@ -176,11 +197,12 @@ int Run(int argc, char** argv) {
     const Eigen::Vector3d ray =
         Eigen::Vector3d((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0).normalized();
     // Tilt measured from the line of sight: turn the head-on tag about an
-    // axis across it. Half the tags upright (roll within 5 degrees), as on
-    // posts and robots, whose edges run along the pixel grid; half at any
-    // roll.
+    // axis across it. Half the tags upright (roll within
+    // --upright-roll-deg), as on posts and robots, whose edges run along the
+    // pixel grid; half at any roll.
     const bool upright = unit(rng) < 0.5;
-    const double roll_rad = upright ? (unit(rng) - 0.5) * 10.0 * kDeg : unit(rng) * 2.0 * M_PI;
+    const double roll_rad =
+        upright ? (unit(rng) - 0.5) * 2.0 * args.upright_roll_deg * kDeg : unit(rng) * 2.0 * M_PI;
     const Eigen::Matrix3d face_camera =
         Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), ray).toRotationMatrix();
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();

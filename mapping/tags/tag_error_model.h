@@ -5,15 +5,18 @@
 // factors take it: a 6x6 covariance over [dt (m, camera frame); dtheta (rad,
 // tag frame, right)], or a refusal.
 //
-// Two models, compared by bench_tag_model (kTable is the default):
+// Two models, compared by bench_tag_model (kAnalytic is the default):
 //   - kTable, the thesis's two-step model (6.2.3): per degree of freedom the
 //     larger of the offline table's maximum error at the detection's
 //     distance and tilt and the online spread under +-delta_px corner
 //     perturbations, scaled to a standard deviation;
 //   - kAnalytic: corner noise propagated through the projection's Jacobian,
 //     Sigma = sigma_c^2 (J^T J)^-1, where the corner noise sigma_c grows as
-//     the detector's corners get worse (CornerSigmaPx): seen obliquely,
-//     small in the image, or close to flipping under the perturbation.
+//     the detector's corners get worse or the pose less linear
+//     (CornerSigmaPx): seen obliquely, nearly head-on, small in the image,
+//     or close to flipping under the perturbation; edges along the pixel
+//     rows or columns add an offset shared by their two corners
+//     (AlignedEdgeCovariance).
 // Both refuse a detection whose pose is unstable: the perturbed corners
 // flip it to the other solution of the planar ambiguity, the two solutions
 // fit the corners nearly equally well, or the tag is seen nearly edge-on.
@@ -31,14 +34,12 @@ namespace rover::mapping {
 enum class TagErrorModelKind { kTable, kAnalytic };
 
 struct TagErrorModelOptions {
-  /// kTable by default: on bench_tag_model's detections (half of them
-  /// upright, seeds 1-10) it keeps 95.6-99.4 % within the chi^2(6) 95 %
-  /// bound, though 6-10x too conservative by the median NEES (1.1-4.8x by
-  /// the mean). kAnalytic is 1.8-2.5x too conservative by the median (within
-  /// 2x by the mean) but keeps only 85.8-93.1 %: upright tags seen head-on,
-  /// whose edges run along the pixel grid, have corner errors larger than
-  /// its noise and correlated between corners.
-  TagErrorModelKind kind = TagErrorModelKind::kTable;
+  /// kAnalytic by default, the more consistent on bench_tag_model's
+  /// detections (see the mapping README for the figures per seed): within
+  /// 2x of consistent by the mean NEES, where kTable is up to 4.8x too
+  /// conservative by the mean (6-10x by the median). Its parameters below
+  /// were fitted on the bench's seeds 1-10.
+  TagErrorModelKind kind = TagErrorModelKind::kAnalytic;
   /// The calibration's pixel error: the online perturbation +-delta [px].
   double corner_delta_px = 0.3;
   /// kTable: standard deviation per maximum error. The thesis takes the
@@ -50,10 +51,24 @@ struct TagErrorModelOptions {
   /// at 0.35).
   double sigma_per_max_error = 0.15;
   /// kAnalytic: standard deviation of one corner coordinate [px] for a tag
-  /// seen head-on and at least `small_tag_side_px` across. Fitted on the
-  /// bench's rendered detections (blur 0.3-1.1 px, noise 0-3 DN); a real
-  /// camera's may differ: compare with bench_tag_model on its images.
-  double corner_sigma_px = 0.04;
+  /// seen at frontal_tilt_deg or more and at least `small_tag_side_px`
+  /// across, before the tilt's growth. Fitted on the bench's rendered
+  /// detections (blur 0.3-1.1 px, noise 0-3 DN); a real camera's may
+  /// differ: compare with bench_tag_model on its images.
+  double corner_sigma_px = 0.048;
+  /// kAnalytic: the corner noise grows as (1/cos(tilt))^tilt_sigma_exponent.
+  /// At 1 (the foreshortening of the edges) tags seen head-on were 2x under
+  /// their errors by the mean NEES and tags at 50-60 degrees 2x over.
+  double tilt_sigma_exponent = 0.5;
+  /// kAnalytic: within frontal_tilt_deg of head-on the corner noise grows
+  /// linearly to (1 + frontal_sigma_gain) times at head-on, where the two
+  /// solutions of the planar ambiguity close in.
+  double frontal_sigma_gain = 0.75;
+  double frontal_tilt_deg = 30.0;
+  /// kAnalytic: offset noise [px] of an edge along the pixel rows or columns,
+  /// shared by its two corners (AlignedEdgeCovariance), before the growth
+  /// factors above. 0: independent corners only.
+  double aligned_edge_sigma_px = 0.08;
   /// kAnalytic: below this mean side length [px] the corner noise grows as
   /// (small_tag_side_px / side)^0.75: the detector fits each edge to fewer
   /// pixels.
@@ -111,13 +126,40 @@ struct TagUncertainty {
 /// through the Jacobian of the four corners' projections.
 ///
 /// The corner noise of the analytic model for a tag at T_camera_tag: the
-/// options' head-on noise divided by the cosine of the tilt, grown for a
-/// small tag and by flip_sigma_factor when `flipped` > 0.
+/// options' noise grown with the tilt (tilt_sigma_exponent), near head-on
+/// (frontal_sigma_gain), for a small tag, and by flip_sigma_factor when
+/// `flipped` > 0.
 double CornerSigmaPx(const TagErrorModelOptions& options, const Eigen::Isometry3d& T_camera_tag,
                      double tag_size_m, const calib::RectifiedIntrinsics& camera, int flipped);
 
 Matrix6d AnalyticTagCovariance(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
                                const calib::RectifiedIntrinsics& camera, double corner_sigma_px);
+
+using Matrix8d = Eigen::Matrix<double, 8, 8>;
+using Vector8d = Eigen::Matrix<double, 8, 1>;
+
+/// The same with a full covariance of the four corners [x0 y0 ... x3 y3]
+/// [px^2]: Sigma = P C P^T, P = (J^T J)^-1 J^T (the pose minimises the
+/// unweighted reprojection error).
+Matrix6d AnalyticTagCovariance(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
+                               const calib::RectifiedIntrinsics& camera,
+                               const Matrix8d& corner_covariance);
+
+/// Corner covariance [px^2] from edges that run along the pixel rows or
+/// columns: the detector fits each edge to pixels that share one sub-pixel
+/// phase, so its offset error (edge_sigma_px, along the edge's normal) does
+/// not average out along it and moves both of its corners together. The
+/// weight fades to 0 as the phase sweeps one pixel along the edge (length
+/// times the sine of its angle to the nearest pixel axis).
+Matrix8d AlignedEdgeCovariance(const std::array<Eigen::Vector2d, 4>& corners_px,
+                               double edge_sigma_px);
+
+/// The analytic model's corner covariance for a tag at T_camera_tag whose
+/// independent corner noise is sigma_px (CornerSigmaPx): sigma_px^2 I plus
+/// the aligned edges' offsets, grown by the same factor.
+Matrix8d AnalyticCornerCovariance(const TagErrorModelOptions& options,
+                                  const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
+                                  const calib::RectifiedIntrinsics& camera, double sigma_px);
 
 class TagErrorModel {
  public:
@@ -146,8 +188,13 @@ class TagErrorModel {
   /// solution's rotation. `best` (ForSolution of pose.best) plus the outer
   /// product of twice the difference between the two solutions: the
   /// alternative lies half a sigma away along it, while the position, which
-  /// both solutions share to millimetres, keeps nearly its own sigma.
-  static TagUncertainty Inflated(const TagPose& pose, const TagUncertainty& best);
+  /// both solutions share to millimetres, keeps nearly its own sigma. With
+  /// `alternative` (ForSolution of pose.alternative) accepted, its rotation
+  /// covariance is added too: the truth may lie near the alternative, off
+  /// the line between the two by the alternative's own error (in the
+  /// landmark missions such a sighting 23 deg off had a NEES of 45 without).
+  static TagUncertainty Inflated(const TagPose& pose, const TagUncertainty& best,
+                                 const TagUncertainty* alternative = nullptr);
 
   const TagErrorModelOptions& options() const { return options_; }
 

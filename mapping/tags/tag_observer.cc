@@ -64,6 +64,10 @@ TagObserverOptions TagObserverOptions::Load(const ConfigNode& node) {
   o.model.sigma_per_max_error =
       node.Get<double>("sigma_per_max_error", o.model.sigma_per_max_error);
   o.model.corner_sigma_px = node.Get<double>("corner_sigma_px", o.model.corner_sigma_px);
+  o.model.tilt_sigma_exponent =
+      node.Get<double>("tilt_sigma_exponent", o.model.tilt_sigma_exponent);
+  o.model.frontal_sigma_gain = node.Get<double>("frontal_sigma_gain", o.model.frontal_sigma_gain);
+  o.model.frontal_tilt_deg = node.Get<double>("frontal_tilt_deg", o.model.frontal_tilt_deg);
   o.model.small_tag_side_px = node.Get<double>("small_tag_side_px", o.model.small_tag_side_px);
   o.model.flip_sigma_factor = node.Get<double>("flip_sigma_factor", o.model.flip_sigma_factor);
   o.model.max_tilt_deg = node.Get<double>("max_tilt_deg", o.model.max_tilt_deg);
@@ -211,7 +215,7 @@ std::vector<TagObservation> TagObserver::Observe(const cv::Mat& rectified) {
                                        &o.uncertainty.perturbation),
                      model.ForSolution(o.pose->alternative.T_camera_tag, o.marker->size_m, camera_,
                                        &o.uncertainty.perturbation)};
-      o.inflated = TagErrorModel::Inflated(*o.pose, o.solutions[0]);
+      o.inflated = TagErrorModel::Inflated(*o.pose, o.solutions[0], &o.solutions[1]);
     }
     o.accepted = o.uncertainty.accepted;
     o.refusal = o.uncertainty.refusal;

@@ -31,7 +31,11 @@ TagErrorTableSpec CoarseSpec() {
   return spec;
 }
 
-TagErrorModelOptions TableOptions() { return TagErrorModelOptions{}; }
+TagErrorModelOptions TableOptions() {
+  TagErrorModelOptions o;
+  o.kind = TagErrorModelKind::kTable;
+  return o;
+}
 
 TagErrorModelOptions AnalyticOptions() {
   TagErrorModelOptions o;
@@ -148,6 +152,18 @@ TEST(TagErrorModelTest, AnInflatedUncertaintyCoversBothSolutions) {
   EXPECT_GT(d.dot(best.covariance.ldlt().solve(d)), 12.6) << "not covered before";
   // ... and the position keeps its sigma across the line of sight.
   EXPECT_LT(inflated.sigma(0), 3.0 * best.covariance(0, 0) / std::sqrt(best.covariance(0, 0)));
+  // With the alternative's own rotation covariance: at least that much in
+  // every rotation direction, the position as before.
+  const TagUncertainty alternative =
+      model.ForSolution(pose->alternative.T_camera_tag, kTagSizeM, camera);
+  ASSERT_TRUE(alternative.accepted);
+  const TagUncertainty both = TagErrorModel::Inflated(*pose, best, &alternative);
+  const Eigen::Matrix3d extra =
+      both.covariance.bottomRightCorner<3, 3>() - inflated.covariance.bottomRightCorner<3, 3>();
+  EXPECT_TRUE(extra.isApprox(alternative.covariance.bottomRightCorner<3, 3>()));
+  const Eigen::Matrix3d position = inflated.covariance.topLeftCorner<3, 3>();
+  const Eigen::Matrix3d position_both = both.covariance.topLeftCorner<3, 3>();
+  EXPECT_TRUE(position_both.isApprox(position));
 }
 
 TEST(TagErrorModelTest, AnUnstablePoseIsRefusedAsAmbiguous) {
@@ -201,45 +217,61 @@ TEST(TagErrorModelTest, CornersThatAreNotASquareAreRefused) {
 
 TEST(TagErrorModelTest, TheCornerNoiseGrowsObliquelySmallAndNearTheAmbiguity) {
   const calib::RectifiedIntrinsics camera = TestCamera();
-  const TagErrorModelOptions o = AnalyticOptions();
-  // Head-on and large (about 100 px across at 1 m): the options' noise.
-  EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, 0.0), kTagSizeM, camera, 0), o.corner_sigma_px, 1e-9);
-  // 60 degrees: twice as much.
+  TagErrorModelOptions o = AnalyticOptions();
+  o.aligned_edge_sigma_px = 0.0;  // independent corners: a scaled sigma^2 (J^T J)^-1
+  const double head_on_px = (1.0 + o.frontal_sigma_gain) * o.corner_sigma_px;
+  // Head-on and large (about 100 px across at 1 m): the options' noise with
+  // the near-frontal gain.
+  EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, 0.0), kTagSizeM, camera, 0), head_on_px, 1e-9);
+  // Halfway to frontal_tilt_deg: half the gain (and the tilt's growth).
+  const double half_rad = 0.5 * o.frontal_tilt_deg * M_PI / 180.0;
+  EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, half_rad), kTagSizeM, camera, 0),
+              (1.0 + 0.5 * o.frontal_sigma_gain) * o.corner_sigma_px *
+                  std::pow(1.0 / std::cos(half_rad), o.tilt_sigma_exponent),
+              1e-6);
+  // 60 degrees, beyond the near-frontal range: 2^exponent as much.
   EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, M_PI / 3.0), kTagSizeM, camera, 0),
-              2.0 * o.corner_sigma_px, 1e-6);
+              std::pow(2.0, o.tilt_sigma_exponent) * o.corner_sigma_px, 1e-6);
   // A flipping detection: by the flip factor.
   EXPECT_NEAR(CornerSigmaPx(o, TagAt(1.0, 0.0), kTagSizeM, camera, 3),
-              o.flip_sigma_factor * o.corner_sigma_px, 1e-9);
+              o.flip_sigma_factor * head_on_px, 1e-9);
   // Half the reference side: 2^0.75 as much.
   const auto c = ProjectTagCorners(TagAt(1.0, 0.0), kTagSizeM, camera);
   const double side_at_1m_px = (c[1] - c[0]).norm();
   const double distance_m = 2.0 * side_at_1m_px / o.small_tag_side_px;
   EXPECT_NEAR(CornerSigmaPx(o, TagAt(distance_m, 0.0), kTagSizeM, camera, 0),
-              std::pow(2.0, 0.75) * o.corner_sigma_px, 1e-3 * o.corner_sigma_px);
-  // The analytic covariance follows it: four times the variance at 60
-  // degrees as with the head-on noise.
+              std::pow(2.0, 0.75) * head_on_px, 1e-3 * head_on_px);
+  // The analytic covariance follows it: 2^(2 exponent) times the variance at
+  // 60 degrees as with the options' noise.
   const TagErrorModel model(o, std::nullopt);
   const Eigen::Isometry3d T = TagAt(1.0, M_PI / 3.0);
   const TagUncertainty u = model.ForSolution(T, kTagSizeM, camera);
   ASSERT_TRUE(u.accepted);
   const Matrix6d head_on_noise = AnalyticTagCovariance(T, kTagSizeM, camera, o.corner_sigma_px);
-  EXPECT_TRUE(
-      u.covariance.isApprox(4.0 * o.flip_sigma_factor * o.flip_sigma_factor * head_on_noise, 1e-6))
+  EXPECT_TRUE(u.covariance.isApprox(std::pow(4.0, o.tilt_sigma_exponent) * o.flip_sigma_factor *
+                                        o.flip_sigma_factor * head_on_noise,
+                                    1e-6))
       << "a solution chosen between two counts as flipping";
 }
 
-TEST(TagErrorModelTest, CoversTheTrueErrorOfRenderedDetections) {
-  // Tags rendered with other blur, noise and contrast than the table's,
-  // anywhere in the view: the accepted detections' NEES stays within the
-  // chi^2(6) 95 % bound for at least 90 % of them, and no pose on the wrong
-  // side of the ambiguity is accepted.
+struct Coverage {
+  int accepted = 0;
+  int in_bound = 0;
+  int wrong_accepted = 0;
+  double median_nees = 0.0;
+};
+
+// Tags rendered with other blur, noise and contrast than the table's,
+// anywhere in the view, upright (their edges along the pixel rows and
+// columns, as a level rover sees a post's tag): the accepted detections'
+// NEES under `model`.
+Coverage CoverageOfRenderedDetections(const TagErrorModel& model) {
   const calib::RectifiedIntrinsics camera = TestCamera();
-  const TagErrorModel model(TableOptions(), Table());
   std::vector<double> nees;
   TagDetector detector(TagDetectorOptions{});
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  int accepted = 0, in_bound = 0, wrong_accepted = 0;
+  Coverage c;
   for (int n = 0; n < 80; ++n) {
     const double d = 0.4 + 4.0 * unit(rng);
     const double tilt = (unit(rng) - 0.5) * 140.0 * M_PI / 180.0;
@@ -257,19 +289,68 @@ TEST(TagErrorModelTest, CoversTheTrueErrorOfRenderedDetections) {
     if (!pose) continue;
     const TagUncertainty u = model.Evaluate(found[0].corners_px, *pose, kTagSizeM, camera);
     if (!u.accepted) continue;
-    ++accepted;
+    ++c.accepted;
     const TagPoseErrors e = TagPoseError(pose->best.T_camera_tag, T);
-    wrong_accepted += e.tail<3>().norm() > 20.0 * M_PI / 180.0;
+    c.wrong_accepted += e.tail<3>().norm() > 20.0 * M_PI / 180.0;
     nees.push_back(e.dot(u.covariance.ldlt().solve(e)));
-    in_bound += nees.back() <= kChi2Six95;
+    c.in_bound += nees.back() <= kChi2Six95;
   }
-  EXPECT_GT(accepted, 40);
-  EXPECT_GE(in_bound, 0.9 * accepted) << in_bound << " of " << accepted;
-  EXPECT_EQ(wrong_accepted, 0);
-  std::nth_element(nees.begin(), nees.begin() + static_cast<std::ptrdiff_t>(nees.size() / 2),
-                   nees.end());
-  const double median = nees[nees.size() / 2];
-  EXPECT_LT(median, 5.3) << "not overconfident";
+  if (!nees.empty()) {
+    std::nth_element(nees.begin(), nees.begin() + static_cast<std::ptrdiff_t>(nees.size() / 2),
+                     nees.end());
+    c.median_nees = nees[nees.size() / 2];
+  }
+  return c;
+}
+
+// At least 90 % of the NEES within the chi^2(6) 95 % bound, the median not
+// above chi^2(6)'s (5.35: not overconfident), and no pose on the wrong side
+// of the ambiguity accepted.
+void ExpectCovered(const Coverage& c) {
+  EXPECT_GT(c.accepted, 40);
+  EXPECT_GE(c.in_bound, 0.9 * c.accepted) << c.in_bound << " of " << c.accepted;
+  EXPECT_EQ(c.wrong_accepted, 0);
+  EXPECT_LT(c.median_nees, 5.3) << "not overconfident";
+}
+
+TEST(TagErrorModelTest, OnlyEdgesAlongThePixelGridShareAnOffset) {
+  // A square 40 px across with its edges along the rows and columns: each
+  // edge's offset moves its two corners together along its normal.
+  const std::array<Eigen::Vector2d, 4> square = {
+      Eigen::Vector2d(100, 100), Eigen::Vector2d(140, 100), Eigen::Vector2d(140, 140),
+      Eigen::Vector2d(100, 140)};
+  const Matrix8d C = AlignedEdgeCovariance(square, 0.1);
+  // Corner 0's y and corner 1's y (the edge 0 -> 1 along x): fully shared.
+  EXPECT_NEAR(C(1, 1), 0.01, 1e-12);
+  EXPECT_NEAR(C(1, 3), 0.01, 1e-12);
+  EXPECT_NEAR(C(0, 2), 0.0, 1e-12) << "x of corners 0 and 1 lie on different vertical edges";
+  EXPECT_NEAR(C(0, 6), 0.01, 1e-12) << "corners 0 and 3 share the vertical edge x = 100";
+  // Rolled by 10 degrees the phase sweeps 7 px along each edge: nothing shared.
+  std::array<Eigen::Vector2d, 4> rolled;
+  const Eigen::Rotation2Dd R(10.0 * M_PI / 180.0);
+  for (std::size_t k = 0; k < 4; ++k) rolled[k] = R * square[k];
+  EXPECT_TRUE(AlignedEdgeCovariance(rolled, 0.1).isZero(1e-15));
+  // By 0.5 degree (0.35 px): partly.
+  const Eigen::Rotation2Dd r(0.5 * M_PI / 180.0);
+  for (std::size_t k = 0; k < 4; ++k) rolled[k] = r * square[k];
+  const double shared = AlignedEdgeCovariance(rolled, 0.1)(1, 3);
+  EXPECT_GT(shared, 0.3 * 0.01);
+  EXPECT_LT(shared, 0.8 * 0.01);
+}
+
+TEST(TagErrorModelTest, TheTableCoversTheTrueErrorOfRenderedDetections) {
+  ExpectCovered(CoverageOfRenderedDetections(TagErrorModel(TableOptions(), Table())));
+}
+
+TEST(TagErrorModelTest, TheAnalyticModelCoversUprightTagsByTheirAlignedEdges) {
+  const TagErrorModelOptions with_edges = AnalyticOptions();
+  ASSERT_GT(with_edges.aligned_edge_sigma_px, 0.0);
+  ExpectCovered(CoverageOfRenderedDetections(TagErrorModel(with_edges, std::nullopt)));
+  // Independent corners alone are overconfident on these tags.
+  TagErrorModelOptions independent = with_edges;
+  independent.aligned_edge_sigma_px = 0.0;
+  const Coverage c = CoverageOfRenderedDetections(TagErrorModel(independent, std::nullopt));
+  EXPECT_LT(c.in_bound, 0.8 * c.accepted) << c.in_bound << " of " << c.accepted;
 }
 
 TEST(TagErrorModelTest, OptionsAreChecked) {

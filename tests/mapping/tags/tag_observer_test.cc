@@ -36,6 +36,7 @@ const std::vector<TagErrorTable>& Tables() {
 
 TagObserverOptions TwoMarkers() {
   TagObserverOptions o;
+  o.model.kind = TagErrorModelKind::kTable;  // the tables' checks and loading
   TagMarker post;
   post.id = 3;
   post.size_m = 0.16;
