@@ -156,7 +156,7 @@ std::vector<TagDetection> TagDetector::Detect(const cv::Mat& mono8,
     if (reason.empty()) {
       out.push_back(std::move(d));
     } else if (refused != nullptr) {
-      refused->push_back({d.family, d.id, reason});
+      refused->push_back({d.family, d.id, reason, d.corners_px});
     }
   }
   apriltag_detections_destroy(found);

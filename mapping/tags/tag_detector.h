@@ -67,7 +67,8 @@ struct TagDetection {
   int id = 0;
   int hamming = 0;               ///< bits corrected
   double decision_margin = 0.0;  ///< the library's
-  std::array<Eigen::Vector2d, 4> corners_px;
+  std::array<Eigen::Vector2d, 4> corners_px{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
+                                            Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
 };
 
@@ -76,6 +77,9 @@ struct TagRefusal {
   std::string family;
   int id = 0;
   std::string reason;
+  /// Where the library found it (logged with the refusal).
+  std::array<Eigen::Vector2d, 4> corners_px{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
+                                            Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
 };
 
 class TagDetector {

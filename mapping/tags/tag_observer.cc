@@ -228,6 +228,7 @@ std::vector<TagObservation> TagObserver::Observe(const cv::Mat& rectified) {
     TagObservation o;
     o.detection.family = r.family;
     o.detection.id = r.id;
+    o.detection.corners_px = r.corners_px;
     o.refusal = r.reason;
     out.push_back(std::move(o));
   }
