@@ -64,7 +64,6 @@ class IncrementalPoseSolver::Impl {
     // Model Hessian weight: the factor adds J^T M J to H and -rho' J^T r to b.
     Matrix6d M = Matrix6d::Identity();
     double rho1 = 1.0;
-    double cost = 0.0;  // 1/2 rho(|r|^2)
   };
 
   // Linearises factor k at the theta of its variables; returns false if the
@@ -88,7 +87,6 @@ class IncrementalPoseSolver::Impl {
     f.J_b = Jb.leftCols<6>();
     f.r = r;
     if (!f.robust) {
-      f.cost = 0.5 * s;
       f.M.setIdentity();
       f.rho1 = 1.0;
       return;
@@ -103,7 +101,6 @@ class IncrementalPoseSolver::Impl {
     // rho' J^T r, hence the fixed point, is the same either way.
     const double c2 = options_.cauchy_scale * options_.cauchy_scale;
     const double u = s / c2;
-    f.cost = 0.5 * c2 * std::log1p(u);
     f.rho1 = 1.0 / (1.0 + u);
     double curvature = (1.0 - u) / (1.0 + u);
     if (!exact_robust_hessian_) curvature = std::max(curvature, 0.0);
@@ -571,12 +568,6 @@ void IncrementalPoseSolver::ResetLinearization(const std::vector<const double*>&
 
 IncrementalPoseSolver::Matrix6d IncrementalPoseSolver::MarginalCovariance(int v) const {
   return impl_->MarginalCovariance(v);
-}
-
-double IncrementalPoseSolver::LinearizedCost() const {
-  double cost = 0.0;
-  for (const auto& f : impl_->factors_) cost += f.cost;
-  return cost;
 }
 
 std::vector<int> IncrementalPoseSolver::Neighbourhood(const std::vector<int>& seeds,

@@ -118,9 +118,6 @@ class IncrementalPoseSolver {
   /// along v's path to the root of the elimination tree.
   Matrix6d MarginalCovariance(int v) const;
 
-  /// 1/2 sum rho(|r|^2) at the linearisation points.
-  double LinearizedCost() const;
-
   /// Variables within `hops` factors of `seeds` (including the seeds).
   std::vector<int> Neighbourhood(const std::vector<int>& seeds, int hops) const;
 

@@ -359,7 +359,6 @@ class RoverGraph::Impl {
       out->reordered = stats.reordered;
       bool shortened = false;
       refine_steps_ = 0;
-      refine_due_ = true;
       if (CostIfLower(before, &shortened)) {
         refine_due_ = !stats.converged || shortened;
         return;
@@ -528,12 +527,12 @@ class RoverGraph::Impl {
   // along its residual nearly zero, so that one step threw a variable 4e8 m
   // away, into the flat tail of the Cauchy loss where no solver brings it
   // back. *shortened: the step taken is a fraction of the full one.
-  std::optional<double> CostIfLower(const CostedEstimate& before, bool* shortened = nullptr) {
+  std::optional<double> CostIfLower(const CostedEstimate& before, bool* shortened) {
     for (int halvings = 0; halvings <= kMaxStepHalvings; ++halvings) {
       CopySolverEstimates();
       const double cost = ProblemCost();
       if (std::isfinite(cost) && cost <= before.cost * (1.0 + kCostTolerance)) {
-        if (shortened != nullptr) *shortened = halvings > 0;
+        *shortened = halvings > 0;
         return cost;
       }
       solver_->ScaleStep(0.5);
