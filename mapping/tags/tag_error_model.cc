@@ -152,6 +152,15 @@ TagErrorModel::TagErrorModel(const TagErrorModelOptions& options,
   }
 }
 
+Matrix6d TagErrorModel::AnalyticCovariance(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
+                                           const calib::RectifiedIntrinsics& camera,
+                                           int flipped) const {
+  const double sigma_px = CornerSigmaPx(options_, T_camera_tag, tag_size_m, camera, flipped);
+  return AnalyticTagCovariance(
+      T_camera_tag, tag_size_m, camera,
+      AnalyticCornerCovariance(options_, T_camera_tag, tag_size_m, camera, sigma_px));
+}
+
 TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& corners_px,
                                        const TagPose& pose, double tag_size_m,
                                        const calib::RectifiedIntrinsics& camera) const {
@@ -184,11 +193,8 @@ TagUncertainty TagErrorModel::Evaluate(const std::array<Eigen::Vector2d, 4>& cor
     u.sigma = options_.sigma_per_max_error * base.cwiseMax(u.perturbation.max_deviation);
     u.covariance = LineOfSightCovariance(u.sigma, pose.best.T_camera_tag.translation());
   } else {
-    const double sigma_px =
-        CornerSigmaPx(options_, pose.best.T_camera_tag, tag_size_m, camera, u.perturbation.flipped);
-    u.covariance = AnalyticTagCovariance(
-        pose.best.T_camera_tag, tag_size_m, camera,
-        AnalyticCornerCovariance(options_, pose.best.T_camera_tag, tag_size_m, camera, sigma_px));
+    u.covariance =
+        AnalyticCovariance(pose.best.T_camera_tag, tag_size_m, camera, u.perturbation.flipped);
     u.sigma = u.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   }
   if (!u.covariance.allFinite() || !(u.sigma.array() > 0.0).all()) {
@@ -229,10 +235,7 @@ TagUncertainty TagErrorModel::ForSolution(const Eigen::Isometry3d& T_camera_tag,
   } else {
     // Chosen between two solutions: as close to the ambiguity as a flipping
     // detection, whatever the perturbation counted.
-    const double sigma_px = CornerSigmaPx(options_, T_camera_tag, tag_size_m, camera, 1);
-    u.covariance = AnalyticTagCovariance(
-        T_camera_tag, tag_size_m, camera,
-        AnalyticCornerCovariance(options_, T_camera_tag, tag_size_m, camera, sigma_px));
+    u.covariance = AnalyticCovariance(T_camera_tag, tag_size_m, camera, 1);
     u.sigma = u.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   }
   if (!u.covariance.allFinite() || !(u.sigma.array() > 0.0).all()) {

@@ -202,6 +202,11 @@ class TagErrorModel {
   const TagErrorModelOptions& options() const { return options_; }
 
  private:
+  /// The analytic model's pose covariance for a tag at T_camera_tag with
+  /// `flipped` of the perturbed poses flipping.
+  Matrix6d AnalyticCovariance(const Eigen::Isometry3d& T_camera_tag, double tag_size_m,
+                              const calib::RectifiedIntrinsics& camera, int flipped) const;
+
   TagErrorModelOptions options_;
   std::optional<TagErrorTable> table_;
 };
