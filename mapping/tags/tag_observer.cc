@@ -68,6 +68,8 @@ TagObserverOptions TagObserverOptions::Load(const ConfigNode& node) {
       node.Get<double>("tilt_sigma_exponent", o.model.tilt_sigma_exponent);
   o.model.frontal_sigma_gain = node.Get<double>("frontal_sigma_gain", o.model.frontal_sigma_gain);
   o.model.frontal_tilt_deg = node.Get<double>("frontal_tilt_deg", o.model.frontal_tilt_deg);
+  o.model.aligned_edge_sigma_px =
+      node.Get<double>("aligned_edge_sigma_px", o.model.aligned_edge_sigma_px);
   o.model.small_tag_side_px = node.Get<double>("small_tag_side_px", o.model.small_tag_side_px);
   o.model.flip_sigma_factor = node.Get<double>("flip_sigma_factor", o.model.flip_sigma_factor);
   o.model.max_tilt_deg = node.Get<double>("max_tilt_deg", o.model.max_tilt_deg);

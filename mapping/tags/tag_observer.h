@@ -57,7 +57,7 @@ struct TagObserverOptions {
   void Validate() const;
   /// Keys: families, max_hamming, min_decision_margin, quad_decimate,
   /// corner_delta_px, sigma_per_max_error, corner_sigma_px,
-  /// tilt_sigma_exponent, frontal_sigma_gain, frontal_tilt_deg,
+  /// tilt_sigma_exponent, frontal_sigma_gain, frontal_tilt_deg, aligned_edge_sigma_px,
   /// small_tag_side_px, flip_sigma_factor, max_tilt_deg,
   /// max_reprojection_rmse_px, max_flipped_fraction, max_ambiguity_ratio,
   /// model (table | analytic), markers: [{id, size_m,

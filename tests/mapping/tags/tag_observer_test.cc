@@ -117,7 +117,7 @@ TEST(TagObserverTest, TablesMustFitTheCameraAndEveryMarkerSize) {
 TEST(TagObserverTest, LoadsItsConfigurationAndNamesWhatIsWrong) {
   const TagObserverOptions o = TagObserverOptions::Load(ConfigNode::LoadString(
       "families: [tag36h11]\nquad_decimate: 1\nmodel: analytic\ncorner_sigma_px: 0.05\n"
-      "max_tilt_deg: 70\nmarkers:\n"
+      "aligned_edge_sigma_px: 0.1\nmax_tilt_deg: 70\nmarkers:\n"
       "  - {id: 3, size_m: 0.16, landmark: 12}\n  - {id: 7, size_m: 0.24, robot: 1}\n",
       "tags.yaml"));
   ASSERT_EQ(o.markers.size(), 2u);
@@ -125,6 +125,7 @@ TEST(TagObserverTest, LoadsItsConfigurationAndNamesWhatIsWrong) {
   EXPECT_EQ(o.markers[1].carrier, TagMarker::Carrier::kRobot);
   EXPECT_EQ(o.model.kind, TagErrorModelKind::kAnalytic);
   EXPECT_DOUBLE_EQ(o.model.corner_sigma_px, 0.05);
+  EXPECT_DOUBLE_EQ(o.model.aligned_edge_sigma_px, 0.1);
   EXPECT_DOUBLE_EQ(o.model.max_tilt_deg, 70.0);
   EXPECT_DOUBLE_EQ(o.detector.quad_decimate, 1.0);
   try {
