@@ -100,16 +100,21 @@ TEST(TagAmbiguityResolverTest, SightingsAlongOneLineOfSightDecideNothing) {
   // one does, so agreement cannot tell them apart. Here the right one is
   // noisier (6 deg apart from sighting to sighting) and the wrong one
   // gathers all the support: without the view change it would be taken.
-  TagAmbiguityResolver resolver;
   const Eigen::Vector3d towards_tag = (TrueTag().translation() - CameraAt(0)).normalized();
-  for (uint64_t k = 1; k <= 8; ++k) {
+  // Sighting k, k = 1..8: the right solution turned by 6k deg, the camera
+  // 0.5 k m closer along one line of sight.
+  const auto sighting = [&](uint64_t k) {
     Eigen::Isometry3d noisy = TrueTag();
     noisy.linear() =
         noisy.linear() *
         Eigen::AngleAxisd(6.0 * static_cast<double>(k) * kDeg, Eigen::Vector3d::UnitZ()).matrix();
     TagPlacements s = Ambiguous(k, Wrong(40.0 * kDeg), noisy);
     s.p_local_cam = CameraAt(0) + 0.5 * static_cast<double>(k) * towards_tag;
-    EXPECT_TRUE(resolver.Add(s).empty()) << "sighting " << k;
+    return s;
+  };
+  TagAmbiguityResolver resolver;
+  for (uint64_t k = 1; k <= 8; ++k) {
+    EXPECT_TRUE(resolver.Add(sighting(k)).empty()) << "sighting " << k;
   }
   EXPECT_EQ(resolver.waiting(), 8u);
   TagAmbiguityOptions blind;
@@ -117,13 +122,7 @@ TEST(TagAmbiguityResolverTest, SightingsAlongOneLineOfSightDecideNothing) {
   TagAmbiguityResolver without_view_change(blind);
   std::vector<TagDecision> wrong;
   for (uint64_t k = 1; k <= 8; ++k) {
-    Eigen::Isometry3d noisy = TrueTag();
-    noisy.linear() =
-        noisy.linear() *
-        Eigen::AngleAxisd(6.0 * static_cast<double>(k) * kDeg, Eigen::Vector3d::UnitZ()).matrix();
-    TagPlacements s = Ambiguous(k, Wrong(40.0 * kDeg), noisy);
-    s.p_local_cam = CameraAt(0) + 0.5 * static_cast<double>(k) * towards_tag;
-    for (const TagDecision& d : without_view_change.Add(s)) wrong.push_back(d);
+    for (const TagDecision& d : without_view_change.Add(sighting(k))) wrong.push_back(d);
   }
   ASSERT_FALSE(wrong.empty()) << "the case the view change guards against";
   EXPECT_EQ(wrong[0].solution, 0) << "the wrong solution";
