@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "mapping/loop/option_checks.h"
+#include "mapping/tags/tag_border_fit.h"
 #include "mapping/tags/tag_family.h"
 
 namespace rover::mapping {
@@ -65,6 +66,7 @@ void TagDetectorOptions::Validate() const {
   CheckRange(kName, "decode_sharpening", decode_sharpening, 0.0, 10.0);
   CheckRange(kName, "border_margin_px", border_margin_px, 0.0, 100.0);
   CheckPositive(kName, "min_area_px2", min_area_px2);
+  CheckRange(kName, "max_border_offset_px", max_border_offset_px, 0.0, 100.0);
   CheckRange(kName, "threads", threads, 1, 64);
 }
 
@@ -151,6 +153,18 @@ std::vector<TagDetection> TagDetector::Detect(const cv::Mat& mono8,
     } else if (!convex || !(area >= options_.min_area_px2)) {
       why << "degenerate quad (area " << area << " px^2, " << (convex ? "convex" : "not convex")
           << ")";
+    }
+    if (why.tellp() == 0 && options_.max_border_offset_px > 0.0) {
+      const TagBorderFit border = FitTagBorder(
+          mono8, d.corners_px, {det->family->width_at_border, det->family->reversed_border});
+      if (!border.measured) {
+        why << "its sides lie too close to the edge of the image to check them against the tag's "
+               "border";
+      } else if (!(border.worst_offset_px <= options_.max_border_offset_px)) {
+        why << "corner " << border.worst_corner << " lies " << border.worst_offset_px
+            << " px off the tag's border seen in the image (at most "
+            << options_.max_border_offset_px << " px)";
+      }
     }
     const std::string reason = why.str();
     if (reason.empty()) {

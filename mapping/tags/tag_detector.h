@@ -6,7 +6,8 @@
 // must pass the checks the graph relies on: few corrected bits, a clear
 // decision margin, all four corners inside the image (a tag cut by the image
 // border has at least one corner guessed), and a convex quad of some area (a
-// degenerate homography gives no pose). What fails is returned as a refusal
+// degenerate homography gives no pose), and sides that follow the tag's
+// border in the image (tag_border_fit.h). What fails is returned as a refusal
 // that says why, so mapd can count it and carry on.
 //
 // Corners follow OpenCV's pixel convention (the centre of the top-left pixel
@@ -53,6 +54,12 @@ struct TagDetectorOptions {
   double border_margin_px = 2.0;
   /// Smallest quad area [px^2]: below it the pose is not worth a factor.
   double min_area_px2 = 100.0;
+  /// A tag whose quad has a corner further than this from the border seen
+  /// in the image (FitTagBorder) is refused: the library's segmentation ran
+  /// past a thin or dim margin, and the pose from that corner may be the
+  /// wrong solution of the ambiguity with nothing in the fit to show it.
+  /// 0 turns the check off.
+  double max_border_offset_px = 0.75;
   /// Library worker threads (mapd: 1, one low-priority thread).
   int threads = 1;
 

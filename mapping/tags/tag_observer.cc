@@ -57,6 +57,8 @@ TagObserverOptions TagObserverOptions::Load(const ConfigNode& node) {
   o.detector.min_decision_margin =
       node.Get<double>("min_decision_margin", o.detector.min_decision_margin);
   o.detector.quad_decimate = node.Get<double>("quad_decimate", o.detector.quad_decimate);
+  o.detector.max_border_offset_px =
+      node.Get<double>("max_border_offset_px", o.detector.max_border_offset_px);
   o.model.kind = node.GetEnum<TagErrorModelKind>(
       "model", {{"table", TagErrorModelKind::kTable}, {"analytic", TagErrorModelKind::kAnalytic}},
       o.model.kind);

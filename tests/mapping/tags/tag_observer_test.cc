@@ -116,7 +116,8 @@ TEST(TagObserverTest, TablesMustFitTheCameraAndEveryMarkerSize) {
 
 TEST(TagObserverTest, LoadsItsConfigurationAndNamesWhatIsWrong) {
   const TagObserverOptions o = TagObserverOptions::Load(ConfigNode::LoadString(
-      "families: [tag36h11]\nquad_decimate: 1\nmodel: analytic\ncorner_sigma_px: 0.05\n"
+      "families: [tag36h11]\nquad_decimate: 1\nmax_border_offset_px: 0.6\nmodel: "
+      "analytic\ncorner_sigma_px: 0.05\n"
       "aligned_edge_sigma_px: 0.1\nmax_tilt_deg: 70\nmarkers:\n"
       "  - {id: 3, size_m: 0.16, landmark: 12}\n  - {id: 7, size_m: 0.24, robot: 1}\n",
       "tags.yaml"));
@@ -128,6 +129,7 @@ TEST(TagObserverTest, LoadsItsConfigurationAndNamesWhatIsWrong) {
   EXPECT_DOUBLE_EQ(o.model.aligned_edge_sigma_px, 0.1);
   EXPECT_DOUBLE_EQ(o.model.max_tilt_deg, 70.0);
   EXPECT_DOUBLE_EQ(o.detector.quad_decimate, 1.0);
+  EXPECT_DOUBLE_EQ(o.detector.max_border_offset_px, 0.6);
   try {
     TagObserverOptions::Load(
         ConfigNode::LoadString("markers:\n  - {id: 3, size_m: 0.16, landmark: 1}\n  - {id: 3, "
