@@ -31,6 +31,9 @@ if(NOT ROVER_FUZZ)
   # GPIO lines through the character device (drivers/gpio, libgpiod v1).
   pkg_check_modules(ARAVIS REQUIRED IMPORTED_TARGET aravis-0.8)
   pkg_check_modules(GPIOD REQUIRED IMPORTED_TARGET libgpiod)
+  # The team's radio link between rovers (core/link/dds): Cyclone DDS's C API,
+  # idlc (cyclonedds-tools) for the datagram type.
+  find_package(CycloneDDS 0.10 REQUIRED)
   if(ROVER_BUILD_TESTS)
     find_package(GTest REQUIRED)
     include(GoogleTest)

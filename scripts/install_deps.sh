@@ -56,6 +56,8 @@ DEBIAN_PACKAGES=(
   libusb-1.0-0-dev           # required by aravis-0.8.pc (pkg-config fails without it)
   libssl-dev                 # SHA-256 of served logs (OpenSSL libcrypto EVP), also needed by cpp-httplib
   python3                    # scripts/check_link_graph.py: the library layering test (tests/architecture)
+  cyclonedds-dev             # Cyclone DDS C API: the team's radio link between rovers (core/link/dds)
+  cyclonedds-tools           # idlc (generates the link's DDS type at build time) and ddsperf
 )
 
 SUDO=""
