@@ -263,7 +263,7 @@ struct TeamSync::Impl {
         const std::span<const uint8_t> bits = r->Bytes((count + 7u) / 8u);
         std::vector<bool> have(count);
         for (uint16_t b = 0; b < count && !r->failed(); ++b) {
-          have[b] = (bits[b / 8u] >> (b % 8u)) & 1u;
+          have[b] = ((static_cast<unsigned>(bits[b / 8u]) >> (b % 8u)) & 1u) != 0;
         }
         h.partial[seq] = std::move(have);
       }

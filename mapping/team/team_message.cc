@@ -1,0 +1,177 @@
+#include "mapping/team/team_message.h"
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "core/link/wire.h"
+#include "core/log/msgs/message_traits.h"
+#include "core/log/msgs/rover_msgs.h"
+
+namespace rover::mapping {
+namespace {
+
+enum class Kind : uint8_t { kConstraint = 1, kMatchClaim = 2, kHeartbeat = 3 };
+
+const char* Name(Kind kind) {
+  switch (kind) {
+    case Kind::kConstraint:
+      return "team constraint";
+    case Kind::kMatchClaim:
+      return "team match claim";
+    case Kind::kHeartbeat:
+      return "team heartbeat";
+  }
+  return "team message";
+}
+
+void WriteHead(link::wire::Writer* w, Kind kind) {
+  w->U8(kTeamMessageVersion);
+  w->U8(static_cast<uint8_t>(kind));
+}
+
+// Reads and checks the version and kind; throws naming what was found.
+void ReadHead(link::wire::Reader* r, Kind kind) {
+  const uint8_t version = r->U8();
+  const uint8_t found = r->U8();
+  if (r->failed()) throw TeamMessageError(std::string(Name(kind)) + ": truncated header");
+  if (version != kTeamMessageVersion) {
+    throw TeamMessageError(std::string(Name(kind)) + ": version " + std::to_string(version) +
+                           ", expected " + std::to_string(kTeamMessageVersion));
+  }
+  if (found != static_cast<uint8_t>(kind)) {
+    throw TeamMessageError(std::string(Name(kind)) + ": kind " + std::to_string(found) +
+                           ", expected " + std::to_string(static_cast<int>(kind)));
+  }
+}
+
+void CheckEnd(const link::wire::Reader& r, Kind kind) {
+  if (r.failed()) throw TeamMessageError(std::string(Name(kind)) + ": truncated");
+  if (r.remaining() != 0) {
+    throw TeamMessageError(std::string(Name(kind)) + ": " + std::to_string(r.remaining()) +
+                           " bytes after the end");
+  }
+}
+
+void WriteKey(link::wire::Writer* w, const GraphKey& key) {
+  w->U8(static_cast<uint8_t>(key.type));
+  w->U32(static_cast<uint32_t>(key.robot));
+  w->I64(key.index);
+}
+
+GraphKey ReadKey(link::wire::Reader* r) {
+  GraphKey key;
+  key.type = static_cast<GraphKey::Type>(r->U8());
+  key.robot = static_cast<int>(r->U32());
+  key.index = r->I64();
+  return key;
+}
+
+double ReadDouble(link::wire::Reader* r) {
+  const uint64_t bits = r->U64();
+  double v = 0.0;
+  static_assert(sizeof(v) == sizeof(bits));
+  std::memcpy(&v, &bits, sizeof(v));
+  return v;
+}
+
+void WriteDouble(link::wire::Writer* w, double v) {
+  uint64_t bits = 0;
+  std::memcpy(&bits, &v, sizeof(v));
+  w->U64(bits);
+}
+
+}  // namespace
+
+std::vector<uint8_t> EncodeConstraint(const GraphFactorRecord& record) {
+  std::vector<uint8_t> out;
+  link::wire::Writer w(&out);
+  WriteHead(&w, Kind::kConstraint);
+  const std::vector<std::byte> cdr =
+      log::SerializeMessage(ToMsg(record, "robot" + std::to_string(record.a.robot)));
+  w.Bytes(std::span(reinterpret_cast<const uint8_t*>(cdr.data()), cdr.size()));
+  return out;
+}
+
+GraphFactorRecord DecodeConstraint(std::span<const uint8_t> bytes) {
+  link::wire::Reader r(bytes);
+  ReadHead(&r, Kind::kConstraint);
+  const std::span<const uint8_t> cdr = r.Bytes(r.remaining());
+  log::rover_msgs::GraphFactor msg;
+  std::string error;
+  if (!log::DeserializeMessage(std::as_bytes(cdr), &msg, &error)) {
+    throw TeamMessageError(std::string(Name(Kind::kConstraint)) + ": " + error);
+  }
+  try {
+    return FromMsg(msg);
+  } catch (const GraphError& e) {
+    throw TeamMessageError(std::string(Name(Kind::kConstraint)) + ": " + e.what());
+  }
+}
+
+std::vector<uint8_t> EncodeMatchClaim(const MatchClaim& claim) {
+  std::vector<uint8_t> out;
+  link::wire::Writer w(&out);
+  WriteHead(&w, Kind::kMatchClaim);
+  WriteKey(&w, claim.a);
+  WriteKey(&w, claim.b);
+  w.U32(claim.claimant);
+  return out;
+}
+
+MatchClaim DecodeMatchClaim(std::span<const uint8_t> bytes) {
+  link::wire::Reader r(bytes);
+  ReadHead(&r, Kind::kMatchClaim);
+  MatchClaim claim;
+  claim.a = ReadKey(&r);
+  claim.b = ReadKey(&r);
+  claim.claimant = r.U32();
+  CheckEnd(r, Kind::kMatchClaim);
+  for (const GraphKey* key : {&claim.a, &claim.b}) {
+    if (key->type != GraphKey::Type::kOrigin || key->robot < 0 || key->index < 0) {
+      throw TeamMessageError(std::string(Name(Kind::kMatchClaim)) +
+                             ": expected two submap origins, found " + key->ToString());
+    }
+  }
+  if (claim.a == claim.b) {
+    throw TeamMessageError(std::string(Name(Kind::kMatchClaim)) + ": " + claim.a.ToString() +
+                           " with itself");
+  }
+  return claim;
+}
+
+std::vector<uint8_t> EncodeHeartbeat(const TeamHeartbeat& heartbeat) {
+  std::vector<uint8_t> out;
+  link::wire::Writer w(&out);
+  WriteHead(&w, Kind::kHeartbeat);
+  w.I64(heartbeat.stamp_ns);
+  w.I64(heartbeat.submap);
+  const Eigen::Vector3d p = heartbeat.T_world_body.translation();
+  const Eigen::Quaterniond q(heartbeat.T_world_body.rotation());
+  for (const double v : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()}) WriteDouble(&w, v);
+  return out;
+}
+
+TeamHeartbeat DecodeHeartbeat(std::span<const uint8_t> bytes) {
+  link::wire::Reader r(bytes);
+  ReadHead(&r, Kind::kHeartbeat);
+  TeamHeartbeat h;
+  h.stamp_ns = r.I64();
+  h.submap = r.I64();
+  double v[7];
+  for (double& x : v) x = ReadDouble(&r);
+  CheckEnd(r, Kind::kHeartbeat);
+  const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+  bool finite = true;
+  for (const double x : v) finite = finite && std::isfinite(x);
+  if (!finite || std::abs(q.norm() - 1.0) > 1e-6) {
+    throw TeamMessageError(std::string(Name(Kind::kHeartbeat)) +
+                           ": the pose is not finite or its quaternion not of unit norm");
+  }
+  h.T_world_body = Eigen::Isometry3d::Identity();
+  h.T_world_body.linear() = q.normalized().toRotationMatrix();
+  h.T_world_body.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return h;
+}
+
+}  // namespace rover::mapping
