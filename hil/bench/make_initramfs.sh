@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the HIL bench's initramfs: busybox-static as the whole userland, the
 # bench's /init (guest_init.sh), and the kernel modules the scenarios need
-# (vcan, can-raw, can-isotp, vivid, 9p over virtio) with everything they
+# (vcan, can-raw, can-isotp, vivid, 9p over virtio; veth, bridge and sch_netem for
+# the team link) with everything they
 # depend on, taken from Debian's linux-image-amd64 so they match the guest
 # kernel exactly.
 #
@@ -26,7 +27,7 @@ file -L "$busybox" 2>/dev/null | grep -q "statically linked" || {
 # Modules in load order: each one after everything it depends on. The
 # order of this list is the order of loading; virtio_pci must come before
 # 9pnet_virtio, or the 9p transport finds no device.
-wanted=(virtio_pci 9pnet_virtio 9p vcan can-raw can-isotp vivid)
+wanted=(virtio_pci 9pnet_virtio 9p vcan can-raw can-isotp vivid veth sch_netem bridge)
 
 declare -A placed=()
 ordered=()

@@ -43,7 +43,12 @@ std::string MakeUnicastConfig(const std::string& interface_name,
       // Datagrams under a 1500-byte MTU: a lost IP fragment never takes a
       // whole DDS message with it.
       "<MaxMessageSize>1400B</MaxMessageSize><FragmentSize>1300B</FragmentSize></General>"
-      "<Discovery><ParticipantIndex>auto</ParticipantIndex><Peers>";
+      "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
+      // A radio goes silent for minutes: keep the peers through it (the
+      // default lease, 10 s, would drop them and make the link rediscover
+      // them over a lossy, delayed radio when it returns), and announce
+      // often, so that a lost announcement costs a second, not 30.
+      "<LeaseDuration>3600s</LeaseDuration><SPDPInterval>1s</SPDPInterval><Peers>";
   for (const std::string& peer : peer_addresses) xml += "<Peer address=\"" + peer + "\"/>";
   xml += "</Peers></Discovery></Domain></CycloneDDS>";
   return xml;

@@ -41,7 +41,8 @@ struct DdsLinkOptions {
 
 /// A configuration for one rover: DDS on `interface_name` only, no
 /// multicast, the other rovers at `peer_addresses` (IPv4 or host names),
-/// datagrams kept under the radio's MTU.
+/// datagrams kept under the radio's MTU, peers kept through an hour of
+/// silence, and discovery announced every second.
 std::string MakeUnicastConfig(const std::string& interface_name,
                               const std::vector<std::string>& peer_addresses);
 
