@@ -296,74 +296,103 @@ struct TeamSync::Impl {
     }
   }
 
-  void HandleFragment(RobotId sender, wire::Reader* r, Time now) {
+  struct Fragment {
     Key key;
-    key.origin = r->U32();
-    key.stream = r->U8();
-    const uint64_t seq = r->U64();
-    const uint32_t total = r->U32();
-    const uint32_t crc = r->U32();
-    const uint16_t index = r->U16();
-    const uint16_t count = r->U16();
+    uint64_t seq = 0;
+    uint32_t total = 0;
+    uint32_t crc = 0;
+    uint16_t index = 0;
+    uint16_t count = 0;
+    std::span<const uint8_t> data;
+    std::string what;  // "fragment i of message o/s/n", for refusals
+  };
+
+  // Reads a fragment and checks it against itself and the team; refuses
+  // (and returns nothing) what does not hold together.
+  std::optional<Fragment> ParseFragment(RobotId sender, wire::Reader* r) {
+    Fragment f;
+    f.key.origin = r->U32();
+    f.key.stream = r->U8();
+    f.seq = r->U64();
+    f.total = r->U32();
+    f.crc = r->U32();
+    f.index = r->U16();
+    f.count = r->U16();
     const std::size_t payload = r->remaining();
-    const std::span<const uint8_t> data = r->Bytes(payload);
-    const std::string what = "fragment " + std::to_string(index) + " of message " +
-                             std::to_string(key.origin) + "/" + std::to_string(key.stream) + "/" +
-                             std::to_string(seq);
-    if (r->failed()) return Refuse("truncated " + what, sender);
-    if (key.stream >= kMaxStreams) return Refuse(what + ": stream out of range", sender);
-    if (seq == 0) return Refuse(what + ": message number 0", sender);
-    if (total > options.max_message_bytes) {
-      return Refuse(what + ": " + std::to_string(total) + " bytes, more than max_message_bytes",
-                    sender);
-    }
-    if (count != FragmentCount(total) || index >= count) {
-      return Refuse(what + ": fragment count " + std::to_string(count) + " does not fit " +
-                        std::to_string(total) + " bytes",
-                    sender);
-    }
-    const std::size_t offset = std::size_t{index} * kFragmentPayloadBytes;
+    f.data = r->Bytes(payload);
+    f.what = "fragment " + std::to_string(f.index) + " of message " + std::to_string(f.key.origin) +
+             "/" + std::to_string(f.key.stream) + "/" + std::to_string(f.seq);
+    const std::size_t offset = std::size_t{f.index} * kFragmentPayloadBytes;
     const std::size_t expected =
-        std::min(kFragmentPayloadBytes, total - std::min<std::size_t>(total, offset));
-    if (payload != expected) {
-      return Refuse(what + ": " + std::to_string(payload) + " payload bytes, expected " +
-                        std::to_string(expected),
-                    sender);
+        std::min(kFragmentPayloadBytes, f.total - std::min<std::size_t>(f.total, offset));
+    std::string why;
+    if (r->failed()) {
+      why = "truncated";
+    } else if (f.key.stream >= kMaxStreams) {
+      why = "stream out of range";
+    } else if (f.seq == 0) {
+      why = "message number 0";
+    } else if (f.total > options.max_message_bytes) {
+      why = std::to_string(f.total) + " bytes, more than max_message_bytes";
+    } else if (f.count != FragmentCount(f.total) || f.index >= f.count) {
+      why = "fragment count " + std::to_string(f.count) + " does not fit " +
+            std::to_string(f.total) + " bytes";
+    } else if (payload != expected) {
+      why = std::to_string(payload) + " payload bytes, expected " + std::to_string(expected);
+    } else if (f.key.origin == endpoint->self()) {
+      why = "origin " + std::to_string(f.key.origin) + " is this rover";
+    } else if (!InTeam(f.key.origin)) {
+      why = "origin " + std::to_string(f.key.origin) + " is not in the team";
     }
-    if (key.origin == endpoint->self() || !InTeam(key.origin)) {
-      return Refuse(what + ": origin " + std::to_string(key.origin) + " is " +
-                        (key.origin == endpoint->self() ? "this rover" : "not in the team"),
-                    sender);
+    if (!why.empty()) {
+      Refuse(f.what + ": " + why, sender);
+      return std::nullopt;
     }
-    Stream& st = store[key];
-    if (st.complete.count(seq) != 0) {
+    return f;
+  }
+
+  void HandleFragment(RobotId sender, wire::Reader* r, Time now) {
+    const std::optional<Fragment> f = ParseFragment(sender, r);
+    if (!f) return;
+    Stream& st = store[f->key];
+    if (st.complete.count(f->seq) != 0) {
       ++stats->duplicate_fragments;
       return;
     }
-    auto [it, added] = st.partial.try_emplace(seq);
+    auto [it, added] = st.partial.try_emplace(f->seq);
     Partial& part = it->second;
     if (added) {
-      part.total_bytes = total;
-      part.crc = crc;
-      part.count = count;
-      part.have.assign(count, false);
-      part.buffer.assign(total, 0);
-    } else if (part.total_bytes != total || part.crc != crc || part.count != count) {
-      return Refuse(what + ": contradicts the fragments already held (size or CRC differ)", sender);
+      part.total_bytes = f->total;
+      part.crc = f->crc;
+      part.count = f->count;
+      part.have.assign(f->count, false);
+      part.buffer.assign(f->total, 0);
+    } else if (part.total_bytes != f->total || part.crc != f->crc || part.count != f->count) {
+      Refuse(f->what + ": contradicts the fragments already held (size or CRC differ)", sender);
+      return;
     }
-    if (part.have[index]) {
+    if (part.have[f->index]) {
       ++stats->duplicate_fragments;
       return;
     }
-    std::copy(data.begin(), data.end(), part.buffer.begin() + static_cast<std::ptrdiff_t>(offset));
-    part.have[index] = true;
-    if (++part.received < part.count) return;
+    const std::size_t offset = std::size_t{f->index} * kFragmentPayloadBytes;
+    std::copy(f->data.begin(), f->data.end(),
+              part.buffer.begin() + static_cast<std::ptrdiff_t>(offset));
+    part.have[f->index] = true;
+    if (++part.received == part.count) Finish(f->key, f->seq, &st, now);
+  }
+
+  // The last fragment of message `seq` arrived: checks the whole message's
+  // CRC and delivers it, or drops it (its fragments are asked for again).
+  void Finish(const Key& key, uint64_t seq, Stream* st, Time now) {
+    const auto it = st->partial.find(seq);
+    Partial& part = it->second;
     if (wire::Crc32(part.buffer) != part.crc) {
       ++stats->checksum_failures;
       stats->last_refusal = "message " + std::to_string(key.origin) + "/" +
                             std::to_string(key.stream) + "/" + std::to_string(seq) +
                             ": CRC of the reassembled message does not match; dropped";
-      st.partial.erase(it);
+      st->partial.erase(it);
       return;
     }
     Message m;
@@ -371,8 +400,8 @@ struct TeamSync::Impl {
     m.fragments = part.count;
     auto bytes = std::make_shared<std::vector<uint8_t>>(std::move(part.buffer));
     m.bytes = bytes;
-    st.partial.erase(it);
-    Complete(&st, seq, m);
+    st->partial.erase(it);
+    Complete(st, seq, m);
     ++stats->delivered;
     delivered.push_back({key.origin, key.stream, seq, *bytes, now});
   }
