@@ -3,27 +3,28 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+
+#include "core/link/option_error.h"
 
 namespace rover::link {
 
 void LinkConditions::Validate() const {
-  const auto fail = [](const std::string& key, const std::string& expected,
-                       const std::string& found) {
-    throw std::invalid_argument("LinkConditions." + key + ": expected " + expected + ", found " +
-                                found);
-  };
-  if (delay < Duration::Zero()) fail("delay", ">= 0", std::to_string(delay.ToSeconds()) + " s");
+  constexpr std::string_view kName = "LinkConditions";
+  if (delay < Duration::Zero())
+    FailOption(kName, "delay", ">= 0", std::to_string(delay.ToSeconds()) + " s");
   if (jitter < Duration::Zero()) {
-    fail("jitter", ">= 0", std::to_string(jitter.ToSeconds()) + " s");
+    FailOption(kName, "jitter", ">= 0", std::to_string(jitter.ToSeconds()) + " s");
   }
-  if (!(loss >= 0.0 && loss <= 1.0)) fail("loss", "0..1", std::to_string(loss));
+  if (!(loss >= 0.0 && loss <= 1.0)) FailOption(kName, "loss", "0..1", std::to_string(loss));
   if (!(std::isfinite(rate_bytes_per_s) && rate_bytes_per_s >= 0.0)) {
-    fail("rate_bytes_per_s", ">= 0 (0: unlimited)", std::to_string(rate_bytes_per_s));
+    FailOption(kName, "rate_bytes_per_s", ">= 0 (0: unlimited)", std::to_string(rate_bytes_per_s));
   }
   for (const Outage& o : outages) {
     if (!(o.end > o.start)) {
-      fail("outages", "end after start",
-           std::to_string(o.start.ToSeconds()) + " .. " + std::to_string(o.end.ToSeconds()) + " s");
+      FailOption(
+          kName, "outages", "end after start",
+          std::to_string(o.start.ToSeconds()) + " .. " + std::to_string(o.end.ToSeconds()) + " s");
     }
   }
 }

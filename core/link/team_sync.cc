@@ -5,8 +5,10 @@
 #include <compare>
 #include <deque>
 #include <stdexcept>
+#include <string_view>
 #include <utility>
 
+#include "core/link/option_error.h"
 #include "core/link/wire.h"
 
 namespace rover::link {
@@ -95,6 +97,15 @@ uint16_t FragmentCount(std::size_t bytes) {
       std::max<std::size_t>(1, (bytes + kFragmentPayloadBytes - 1) / kFragmentPayloadBytes));
 }
 
+// A whole message as the store holds it.
+Message MakeMessage(std::vector<uint8_t> bytes) {
+  Message m;
+  m.crc = wire::Crc32(bytes);
+  m.fragments = FragmentCount(bytes.size());
+  m.bytes = std::make_shared<const std::vector<uint8_t>>(std::move(bytes));
+  return m;
+}
+
 void WriteHeader(wire::Writer* w, uint8_t kind, RobotId sender) {
   w->U32(kMagic);
   w->U8(kVersion);
@@ -111,43 +122,43 @@ void SealDatagram(std::vector<uint8_t>* d) {
 }  // namespace
 
 void TeamSyncOptions::Validate() const {
-  const auto fail = [](const std::string& key, const std::string& expected,
-                       const std::string& found) {
-    throw std::invalid_argument("TeamSyncOptions." + key + ": expected " + expected + ", found " +
-                                found);
-  };
+  constexpr std::string_view kName = "TeamSyncOptions";
   if (summary_interval <= Duration::Zero()) {
-    fail("summary_interval", "> 0", std::to_string(summary_interval.ToSeconds()) + " s");
+    FailOption(kName, "summary_interval", "> 0",
+               std::to_string(summary_interval.ToSeconds()) + " s");
   }
   if (!(std::isfinite(budget_bytes_per_s) && budget_bytes_per_s >= 500.0)) {
-    fail("budget_bytes_per_s", ">= 500 (summaries alone need a few hundred)",
-         std::to_string(budget_bytes_per_s));
+    FailOption(kName, "budget_bytes_per_s", ">= 500 (summaries alone need a few hundred)",
+               std::to_string(budget_bytes_per_s));
   }
   if (!(std::isfinite(burst_bytes) && burst_bytes >= static_cast<double>(kMaxDatagramBytes))) {
-    fail("burst_bytes", ">= " + std::to_string(kMaxDatagramBytes) + " (one datagram)",
-         std::to_string(burst_bytes));
+    FailOption(kName, "burst_bytes", ">= " + std::to_string(kMaxDatagramBytes) + " (one datagram)",
+               std::to_string(burst_bytes));
   }
   if (min_resend <= Duration::Zero()) {
-    fail("min_resend", "> 0", std::to_string(min_resend.ToSeconds()) + " s");
+    FailOption(kName, "min_resend", "> 0", std::to_string(min_resend.ToSeconds()) + " s");
   }
   if (initial_round_trip <= Duration::Zero()) {
-    fail("initial_round_trip", "> 0", std::to_string(initial_round_trip.ToSeconds()) + " s");
+    FailOption(kName, "initial_round_trip", "> 0",
+               std::to_string(initial_round_trip.ToSeconds()) + " s");
   }
   if (peer_silence <= summary_interval) {
-    fail("peer_silence", "longer than summary_interval",
-         std::to_string(peer_silence.ToSeconds()) + " s");
+    FailOption(kName, "peer_silence", "longer than summary_interval",
+               std::to_string(peer_silence.ToSeconds()) + " s");
   }
   if (copies_by_stream.size() > kMaxStreams) {
-    fail("copies_by_stream", "at most " + std::to_string(kMaxStreams) + " entries",
-         std::to_string(copies_by_stream.size()));
+    FailOption(kName, "copies_by_stream", "at most " + std::to_string(kMaxStreams) + " entries",
+               std::to_string(copies_by_stream.size()));
   }
   for (const int copies : copies_by_stream) {
-    if (copies < 1 || copies > 4) fail("copies_by_stream", "1..4 copies", std::to_string(copies));
+    if (copies < 1 || copies > 4)
+      FailOption(kName, "copies_by_stream", "1..4 copies", std::to_string(copies));
   }
   const std::size_t max_fragments = UINT16_MAX;
   if (max_message_bytes == 0 || max_message_bytes > max_fragments * kFragmentPayloadBytes) {
-    fail("max_message_bytes", "1.." + std::to_string(max_fragments * kFragmentPayloadBytes),
-         std::to_string(max_message_bytes));
+    FailOption(kName, "max_message_bytes",
+               "1.." + std::to_string(max_fragments * kFragmentPayloadBytes),
+               std::to_string(max_message_bytes));
   }
 }
 
@@ -304,7 +315,8 @@ struct TeamSync::Impl {
     uint16_t index = 0;
     uint16_t count = 0;
     std::span<const uint8_t> data;
-    std::string what;  // "fragment i of message o/s/n", for refusals
+    std::size_t offset = 0;  // of data in the message
+    std::string what;        // "fragment i of message o/s/n", for refusals
   };
 
   // Reads a fragment and checks it against itself and the team; refuses
@@ -322,9 +334,9 @@ struct TeamSync::Impl {
     f.data = r->Bytes(payload);
     f.what = "fragment " + std::to_string(f.index) + " of message " + std::to_string(f.key.origin) +
              "/" + std::to_string(f.key.stream) + "/" + std::to_string(f.seq);
-    const std::size_t offset = std::size_t{f.index} * kFragmentPayloadBytes;
+    f.offset = std::size_t{f.index} * kFragmentPayloadBytes;
     const std::size_t expected =
-        std::min(kFragmentPayloadBytes, f.total - std::min<std::size_t>(f.total, offset));
+        std::min(kFragmentPayloadBytes, f.total - std::min<std::size_t>(f.total, f.offset));
     std::string why;
     if (r->failed()) {
       why = "truncated";
@@ -375,9 +387,8 @@ struct TeamSync::Impl {
       ++stats->duplicate_fragments;
       return;
     }
-    const std::size_t offset = std::size_t{f->index} * kFragmentPayloadBytes;
     std::copy(f->data.begin(), f->data.end(),
-              part.buffer.begin() + static_cast<std::ptrdiff_t>(offset));
+              part.buffer.begin() + static_cast<std::ptrdiff_t>(f->offset));
     part.have[f->index] = true;
     if (++part.received == part.count) Finish(f->key, f->seq, &st, now);
   }
@@ -625,11 +636,7 @@ uint64_t TeamSync::Publish(uint8_t stream, std::vector<uint8_t> bytes) {
   }
   Stream& st = impl_->store[{self(), stream}];
   const uint64_t seq = st.contiguous + 1;
-  Message m;
-  m.crc = wire::Crc32(bytes);
-  m.fragments = FragmentCount(bytes.size());
-  m.bytes = std::make_shared<const std::vector<uint8_t>>(std::move(bytes));
-  Impl::Complete(&st, seq, std::move(m));
+  Impl::Complete(&st, seq, MakeMessage(std::move(bytes)));
   ++stats_.published;
   return seq;
 }
@@ -646,11 +653,7 @@ void TeamSync::Restore(RobotId origin, uint8_t stream, uint64_t seq, std::vector
   Stream& st = impl_->store[{origin, stream}];
   if (st.complete.count(seq) != 0) return;
   st.partial.erase(seq);
-  Message m;
-  m.crc = wire::Crc32(bytes);
-  m.fragments = FragmentCount(bytes.size());
-  m.bytes = std::make_shared<const std::vector<uint8_t>>(std::move(bytes));
-  Impl::Complete(&st, seq, std::move(m));
+  Impl::Complete(&st, seq, MakeMessage(std::move(bytes)));
 }
 
 void TeamSync::SetHeartbeat(std::vector<uint8_t> bytes) {

@@ -5,6 +5,7 @@
 // appends and a reader that refuses to read past the end (a truncated or
 // hostile datagram sets failed() instead of reading garbage).
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -20,6 +21,8 @@ class Writer {
   void U32(uint32_t v) { Le(v, 4); }
   void U64(uint64_t v) { Le(v, 8); }
   void I64(int64_t v) { Le(static_cast<uint64_t>(v), 8); }
+  /// IEEE 754 binary64, its bits little-endian.
+  void F64(double v) { Le(std::bit_cast<uint64_t>(v), 8); }
   void Bytes(std::span<const uint8_t> b) { out_->insert(out_->end(), b.begin(), b.end()); }
   std::size_t size() const { return out_->size(); }
 
@@ -38,6 +41,7 @@ class Reader {
   uint32_t U32() { return static_cast<uint32_t>(Le(4)); }
   uint64_t U64() { return Le(8); }
   int64_t I64() { return static_cast<int64_t>(Le(8)); }
+  double F64() { return std::bit_cast<double>(Le(8)); }
   /// The next `n` bytes (empty and failed() if fewer are left).
   std::span<const uint8_t> Bytes(std::size_t n) {
     if (failed_ || n > in_.size() - pos_) {

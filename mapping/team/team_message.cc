@@ -1,7 +1,6 @@
 #include "mapping/team/team_message.h"
 
 #include <cmath>
-#include <cstring>
 #include <string>
 
 #include "core/link/wire.h"
@@ -65,20 +64,6 @@ GraphKey ReadKey(link::wire::Reader* r) {
   key.robot = static_cast<int>(r->U32());
   key.index = r->I64();
   return key;
-}
-
-double ReadDouble(link::wire::Reader* r) {
-  const uint64_t bits = r->U64();
-  double v = 0.0;
-  static_assert(sizeof(v) == sizeof(bits));
-  std::memcpy(&v, &bits, sizeof(v));
-  return v;
-}
-
-void WriteDouble(link::wire::Writer* w, double v) {
-  uint64_t bits = 0;
-  std::memcpy(&bits, &v, sizeof(v));
-  w->U64(bits);
 }
 
 }  // namespace
@@ -148,7 +133,7 @@ std::vector<uint8_t> EncodeHeartbeat(const TeamHeartbeat& heartbeat) {
   w.I64(heartbeat.submap);
   const Eigen::Vector3d p = heartbeat.T_world_body.translation();
   const Eigen::Quaterniond q(heartbeat.T_world_body.rotation());
-  for (const double v : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()}) WriteDouble(&w, v);
+  for (const double v : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()}) w.F64(v);
   return out;
 }
 
@@ -159,7 +144,7 @@ TeamHeartbeat DecodeHeartbeat(std::span<const uint8_t> bytes) {
   h.stamp_ns = r.I64();
   h.submap = r.I64();
   double v[7];
-  for (double& x : v) x = ReadDouble(&r);
+  for (double& x : v) x = r.F64();
   CheckEnd(r, Kind::kHeartbeat);
   const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
   bool finite = true;
