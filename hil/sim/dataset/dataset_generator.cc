@@ -8,6 +8,7 @@
 #include "hil/sim/dataset/euroc_writer.h"
 #include "hil/sim/motion/rover_trajectory.h"
 #include "hil/sim/render/stereo_renderer.h"
+#include "hil/sim/scenario/team_rovers.h"
 #include "hil/sim/seed.h"
 #include "hil/sim/sensors/gpio_edge_model.h"
 #include "hil/sim/sensors/imu_model.h"
@@ -19,26 +20,24 @@ namespace {
 double SecondsSince(Time start) { return (Time::Now() - start).ToSeconds(); }
 
 // Everything one rover records, into its own EuRoC-layout folder.
-// `rovers[self]` is the recording rover; `carrier_rover[j]` is the rover that
-// moving tag carrier j belongs to (its own carrier is hidden from its view).
+// `team.trajectories[self]` is the recording rover; its own tag carrier is
+// hidden from its view.
 struct RoverContext {
   const Scenario& scenario;
   const World& world;
-  const std::vector<const RoverTrajectory*>& rovers;
-  const std::vector<std::size_t>& carrier_rover;
+  const TeamRovers& team;
   std::size_t self;
 };
 
 void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
                        const std::string& out_dir, double duration_s, GenerateResult* result) {
   EurocWriter writer(out_dir);
-  const RoverTrajectory& trajectory = *c.rovers[c.self];
+  const RoverTrajectory& trajectory = c.team.trajectories[c.self];
   const Time t0 = kDatasetStartTime;
   const Time end = t0 + Duration::FromSeconds(duration_s);
 
   ImuModelOptions imu_options = c.scenario.imu;
-  imu_options.seed = c.scenario.imu.seed ^ (options.seed * 0x9E3779B97F4A7C15ULL) ^
-                     (c.self * 0xC2B2AE3D27D4EB4FULL);
+  imu_options.seed = RoverImuSeed(c.scenario, options.seed, c.self);
   writer.WriteImuCalibration(ImuCalibrationOf(imu_options));
   const StereoCameraOptions& camera = c.scenario.camera;
   writer.WriteCameraCalibration(0, CameraModelOf(camera, camera.T_body_cam0));
@@ -97,12 +96,8 @@ void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
   StereoRenderer renderer(c.world, camera);
   result->gl_renderer = renderer.gl_renderer();
   RenderedStereoFrame frame;
-  std::vector<const RoverTrajectory*> carriers;
-  std::size_t hidden = kNoHiddenCarrier;
-  for (std::size_t j = 0; j < c.carrier_rover.size(); ++j) {
-    carriers.push_back(c.rovers[c.carrier_rover[j]]);
-    if (c.carrier_rover[j] == c.self) hidden = j;
-  }
+  const std::vector<const RoverTrajectory*> carriers = c.team.CarrierTrajectories();
+  const std::size_t hidden = c.team.HiddenCarrier(c.self);
   std::vector<Eigen::Isometry3d> T_world_carriers;
   for (std::size_t k = 0; k < triggers.size(); ++k) {
     const double t_s = (triggers[k] - t0).ToSeconds();
@@ -129,7 +124,7 @@ void GenerateRoverData(const RoverContext& c, const GenerateOptions& options,
     if (options.progress) {
       const double done = static_cast<double>(c.self) +
                           static_cast<double>(k + 1) / static_cast<double>(triggers.size());
-      options.progress(done / static_cast<double>(c.rovers.size()), t_s);
+      options.progress(done / static_cast<double>(c.team.size()), t_s);
     }
   }
   writer.Close();
@@ -151,38 +146,18 @@ GenerateResult GenerateDataset(const Scenario& scenario, const GenerateOptions& 
 
   // Rover 0 records the main dataset; other rovers drive their own routes and
   // record theirs into <out>/<carrier name>/.
-  std::vector<RoverTrajectory> trajectories;
-  trajectories.reserve(1 + scenario.other_rover_routes.size());
-  trajectories.emplace_back(scenario.route, world.terrain);
-  for (const Route& route : scenario.other_rover_routes) {
-    trajectories.emplace_back(route, world.terrain);
-  }
-  std::vector<const RoverTrajectory*> rovers;
-  for (const RoverTrajectory& t : trajectories) rovers.push_back(&t);
-  // World order of moving carriers: rover_b, rover_c, ..., then rover_a
-  // (the recording rover) when it carries tags too.
-  std::vector<std::size_t> carrier_rover;
-  std::vector<std::string> rover_names(rovers.size());
-  for (const TagCarrier& carrier : world.carriers) {
-    if (carrier.is_static) continue;
-    const std::size_t rover = carrier.name == "rover_a" ? 0 : carrier_rover.size() + 1;
-    if (rover >= rovers.size()) {
-      throw std::invalid_argument("world carrier " + carrier.name + " has no route");
-    }
-    carrier_rover.push_back(rover);
-    rover_names[rover] = carrier.name;
-  }
-
+  const TeamRovers team = MakeTeamRovers(scenario, world);
+  const double main_duration_s = team.trajectories[0].duration_s();
   const double duration_s = options.max_duration_s > 0
-                                ? std::min(options.max_duration_s, rovers[0]->duration_s())
-                                : rovers[0]->duration_s();
+                                ? std::min(options.max_duration_s, main_duration_s)
+                                : main_duration_s;
   result.sim_duration_s = duration_s;
-  for (std::size_t self = 0; self < rovers.size(); ++self) {
-    const RoverContext context{scenario, world, rovers, carrier_rover, self};
-    const std::string dir = self == 0 ? out.string() : (out / rover_names[self]).string();
+  for (std::size_t self = 0; self < team.size(); ++self) {
+    const RoverContext context{scenario, world, team, self};
+    const std::string dir = self == 0 ? out.string() : (out / team.names[self]).string();
     GenerateRoverData(context, options, dir, duration_s, &result);
   }
-  result.rover_datasets = rovers.size();
+  result.rover_datasets = team.size();
   result.wall_time_s = SecondsSince(wall_start);
   return result;
 }
