@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
       "status line, and ends with a summary against the simulator's ground truth whose last\n"
       "line is\n"
       "  RESULT scenario=… distance_m=… filter_final_err_pct=… slam_final_err_pct=…\n"
-      "         imu_drops=… frame_drops=… loop_latency_us_p999=… log=PATH\n"
+      "         imu_drops=… frame_drops=… loop_latency_us_p999=… rover=K log=PATH\n"
       "(slam_final_err_pct is nan here: rover-launch fills it from mapd's log; "
       "loop_latency_us_p999 is the\n"
       "IMU loop's sample-to-estimate latency in real time, the estimator step's wall time in\n"
@@ -28,6 +28,11 @@ int main(int argc, char** argv) {
   rover::sim::MissionOptions options;
   bool realtime = false;
   app.add_option("--sim", options.scenario, "scenario (see `rover-sim list`)")
+      ->capture_default_str();
+  app.add_option("--rover", options.rover,
+                 "which rover of a team scenario this process simulates: 0 drives `route`, k the "
+                 "k-th of `other_rovers` (the others drive theirs in its view); its log is "
+                 "mission-SCENARIO-ROVERNAME.mcap for k > 0")
       ->capture_default_str();
   app.add_option("--seed", options.seed, "world and sensor noise seed")->capture_default_str();
   app.add_flag("--realtime", realtime,

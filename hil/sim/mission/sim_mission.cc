@@ -21,6 +21,7 @@
 #include "hil/sim/live/sim_stereo_camera_driver.h"
 #include "hil/sim/render/stereo_renderer.h"
 #include "hil/sim/scenario/scenario.h"
+#include "hil/sim/scenario/team_rovers.h"
 #include "hil/sim/sensors/gpio_edge_model.h"
 #include "hil/sim/world/world.h"
 
@@ -127,10 +128,17 @@ MissionResult RunMission(const MissionOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   MissionResult result;
   result.scenario = options.scenario;
+  result.rover = options.rover;
   const Scenario scenario =
       LoadScenario(FindScenario(DefaultScenarioDir(), options.scenario), DefaultSimConfigDir());
+  CheckRoverIndex(scenario, options.rover);
   const World world = World::Generate(scenario.world, options.seed);
-  const RoverTrajectory trajectory(scenario.route, world.terrain);
+  // The simulated rover drives its own route; the other rovers of a team
+  // scenario drive theirs in its camera's view, as in `rover-sim generate`.
+  const TeamRovers team = MakeTeamRovers(scenario, world);
+  const RoverTrajectory& trajectory = team.trajectories[options.rover];
+  result.rover_name = team.names[options.rover];
+  result.p_world_body_start_m = trajectory.Evaluate(0.0).p_world_body;
   double duration_s = trajectory.duration_s();
   if (options.max_duration_s > 0.0) duration_s = std::min(duration_s, options.max_duration_s);
   result.sim_duration_s = duration_s;
@@ -140,9 +148,9 @@ MissionResult RunMission(const MissionOptions& options) {
   // stamp on CLOCK_MONOTONIC, as real ones do, from now on.
   const Time start = options.lockstep ? kDatasetStartTime : Time::Now();
   const Time end = start + Duration::FromSeconds(duration_s);
-  // The recording rover's sensors, seeded as `rover-sim generate` seeds them.
+  // The simulated rover's sensors, seeded as `rover-sim generate` seeds them.
   ImuModelOptions imu_options = scenario.imu;
-  imu_options.seed = scenario.imu.seed ^ (options.seed * 0x9E3779B97F4A7C15ULL);
+  imu_options.seed = RoverImuSeed(scenario, options.seed, options.rover);
   WheelOdometryModelOptions wheel_options;
   if (!scenario.wheels_config.empty()) {
     wheel_options = WheelOdometryModelOptions::LoadFile(scenario.wheels_config);
@@ -155,9 +163,9 @@ MissionResult RunMission(const MissionOptions& options) {
   SimWheelCanBus can(wheel_options, trajectory, world.terrain, clock, start,
                      lost_at(options.can_loss_at_s));
   const GpioEdgeModel triggers(scenario.gpio, start);
-  const std::vector<const RoverTrajectory*> carriers;  // no other rovers in the mission yet
-  SimStereoCameraDriver camera(renderer, trajectory, carriers, kNoHiddenCarrier, triggers, clock,
-                               start, lost_at(options.camera_loss_at_s));
+  const std::vector<const RoverTrajectory*> carriers = team.CarrierTrajectories();
+  SimStereoCameraDriver camera(renderer, trajectory, carriers, team.HiddenCarrier(options.rover),
+                               triggers, clock, start, lost_at(options.camera_loss_at_s));
 
   roverd::RoverdOptions rover;
   rover.estimator = EskfOptionsForScenario(scenario, trajectory, wheel_options, true);
@@ -169,11 +177,16 @@ MissionResult RunMission(const MissionOptions& options) {
   rover.lockstep = options.lockstep;
   if (options.board) roverd::ApplyBoard(*options.board, &rover);
 
-  result.log_path =
-      (fs::path(options.out_dir) / ("mission-" + options.scenario + ".mcap")).string();
+  result.log_path = (fs::path(options.out_dir) /
+                     MissionLogName(options.scenario, options.rover, result.rover_name))
+                        .string();
   roverd::RoverdProcessOptions process_options;
   process_options.log_path = result.log_path;
   process_options.metadata["mission"] = {{"scenario", options.scenario},
+                                         // which rover of the scenario: its ground truth is
+                                         // that rover's trajectory (team_rovers.h)
+                                         {"rover", std::to_string(options.rover)},
+                                         {"rover_name", result.rover_name},
                                          {"seed", std::to_string(options.seed)},
                                          {"lockstep", options.lockstep ? "true" : "false"},
                                          // the simulator's time origin: ground truth is
@@ -270,10 +283,19 @@ MissionResult RunMission(const MissionOptions& options) {
   return result;
 }
 
+std::string MissionLogName(const std::string& scenario, std::size_t rover,
+                           const std::string& rover_name) {
+  // Rover 0 keeps the single-rover name, so existing paths stay valid.
+  return rover == 0 ? "mission-" + scenario + ".mcap"
+                    : "mission-" + scenario + "-" + rover_name + ".mcap";
+}
+
 void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
   const roverd::RoverdStats& s = r.stats;
-  out << "mission " << r.scenario << ": " << Fixed(r.sim_duration_s, 1) << " s simulated in "
-      << Fixed(r.wall_time_s, 1) << " s wall time\n";
+  out << "mission " << r.scenario << ", rover " << r.rover << " (" << r.rover_name << ", from x "
+      << Fixed(r.p_world_body_start_m.x(), 2) << " y " << Fixed(r.p_world_body_start_m.y(), 2)
+      << " m): " << Fixed(r.sim_duration_s, 1) << " s simulated in " << Fixed(r.wall_time_s, 1)
+      << " s wall time\n";
   roverd::PrintRoverdStats(
       s, r.ipc ? std::optional<roverd::MapdLinkStats>(r.mapd_link) : std::nullopt, out);
   if (r.ipc) out << "          " << r.frame_switches << " frame switches\n";
@@ -299,7 +321,7 @@ void PrintMissionSummary(const MissionResult& r, std::ostream& out) {
                                                                 : s.step_latency.p999_ns) /
                  1000.0,
              1)
-      << " log=" << r.log_path << "\n";
+      << " rover=" << r.rover << " log=" << r.log_path << "\n";
 }
 
 }  // namespace rover::sim

@@ -6,10 +6,12 @@
 // in real time or lockstep, writing the flight log, with a live status line
 // and a summary scored against the simulator's ground truth.
 
+#include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 
-#include <optional>
+#include <Eigen/Core>
 
 #include "core/calib/camera_model.h"
 #include "firmware/roverd/roverd.h"
@@ -20,10 +22,14 @@ namespace rover::sim {
 
 struct MissionOptions {
   std::string scenario = "short";
+  /// Which rover of a team scenario this mission simulates: 0 drives the
+  /// scenario's `route`, k > 0 the k-th of its `other_rovers` (see
+  /// team_rovers.h). The other rovers drive their routes in its camera's view.
+  std::size_t rover = 0;
   uint64_t seed = 1;
   bool lockstep = true;
   std::string out_dir = "build/mission";
-  double max_duration_s = 0.0;  ///< 0: the whole route
+  double max_duration_s = 0.0;  ///< 0: the simulated rover's whole route
   /// Connect to RouDi and talk to mapd (estimates, stereo pairs and frame
   /// switches out, frame-switch requests in) under this iceoryx runtime
   /// name; empty: run alone.
@@ -45,6 +51,10 @@ struct MissionOptions {
 
 struct MissionResult {
   std::string scenario;
+  std::size_t rover = 0;   ///< MissionOptions::rover
+  std::string rover_name;  ///< its name in the world ("rover_a", "rover_b", ...)
+  /// The simulated rover's true body position at the mission's start, world frame.
+  Eigen::Vector3d p_world_body_start_m = Eigen::Vector3d::Zero();
   std::string log_path;
   double sim_duration_s = 0.0;
   double wall_time_s = 0.0;
@@ -63,8 +73,15 @@ struct MissionResult {
   uint64_t log_drops = 0;
 };
 
-/// Runs the mission. Throws on bad options or an unusable set-up (naming it).
+/// Runs the mission. Throws on bad options or an unusable set-up (naming it);
+/// std::invalid_argument naming the scenario and its number of rovers when
+/// options.rover is not one of them.
 MissionResult RunMission(const MissionOptions& options);
+
+/// The flight log's file name: mission-<scenario>.mcap for rover 0,
+/// mission-<scenario>-<rover name>.mcap for the others.
+std::string MissionLogName(const std::string& scenario, std::size_t rover,
+                           const std::string& rover_name);
 
 /// The summary, ending with the RESULT line of the command-line contract.
 void PrintMissionSummary(const MissionResult& result, std::ostream& out);

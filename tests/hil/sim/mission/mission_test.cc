@@ -7,8 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
 #include <sstream>
+#include <stdexcept>
 
+#include "core/log/mcap/mcap_reader.h"
 #include "estimator/io/log_replay.h"
 #include "tests/support/temp_dir.h"
 
@@ -24,6 +27,9 @@ TEST(MissionTest, ShortMissionRecordsAndReplaysBitExactly) {
   options.out_dir = dir.path().string();
   options.max_duration_s = 12.0;
   const MissionResult r = RunMission(options);
+  // A single rover keeps the single-rover log name.
+  EXPECT_EQ(std::filesystem::path(r.log_path).filename(), "mission-short.mcap");
+  EXPECT_EQ(r.rover_name, "rover_a");
 
   const roverd::RoverdStats& s = r.stats;
   EXPECT_TRUE(r.filter_initialised);
@@ -45,7 +51,7 @@ TEST(MissionTest, ShortMissionRecordsAndReplaysBitExactly) {
   const std::string last = text.substr(text.rfind("RESULT"));
   for (const char* key :
        {"scenario=short", "distance_m=", "filter_final_err_pct=", "slam_final_err_pct=nan",
-        "imu_drops=0", "frame_drops=0", "loop_latency_us_p999=", "log="}) {
+        "imu_drops=0", "frame_drops=0", "loop_latency_us_p999=", "rover=0", "log="}) {
     EXPECT_NE(last.find(key), std::string::npos) << key << " missing from " << last;
   }
 
@@ -101,6 +107,70 @@ TEST(MissionTest, LosingTheCanBusLeavesImuAndVo) {
   EXPECT_LT(r.filter_final_error_pct, 1.0);
   EXPECT_NE(s.health.find("wheels STALE"), std::string::npos) << s.health;
   EXPECT_NE(s.health.find("camera ok"), std::string::npos) << s.health;
+}
+
+// A team scenario run as its second rover: rover_b's own route (it waits
+// at (14, 0) facing west for 45 s), its own log and metadata, and sensors
+// that agree with that truth.
+TEST(MissionTest, RoverOneOfATeamDrivesItsOwnRoute) {
+  const rover::testing::TempDir dir;
+  MissionOptions options;
+  options.scenario = "two-rovers";
+  options.rover = 1;
+  options.seed = 1;
+  options.lockstep = true;
+  options.out_dir = dir.path().string();
+  options.max_duration_s = 6.0;
+  options.images.mode = roverd::ImageLogMode::kNone;
+  const MissionResult r = RunMission(options);
+
+  EXPECT_EQ(r.rover, 1u);
+  EXPECT_EQ(r.rover_name, "rover_b");
+  EXPECT_NEAR(r.p_world_body_start_m.x(), 14.0, 1e-6);
+  EXPECT_NEAR(r.p_world_body_start_m.y(), 0.0, 1e-6);
+  EXPECT_NEAR(r.sim_duration_s, 6.0, 1e-9);
+  EXPECT_EQ(std::filesystem::path(r.log_path).filename(), "mission-two-rovers-rover_b.mcap");
+  EXPECT_NEAR(static_cast<double>(r.stats.imu_samples), 2400.0, 1.0);  // 6 s at 400 Hz
+  // rover_b holds still at its start (rover_a drives off after 2 s): the
+  // truth drives nowhere, and the sensors agree with it. (With rover_a's IMU
+  // the final error was 0.38 m; with rover_b's it is below a millimetre.)
+  ASSERT_TRUE(r.filter_initialised);
+  EXPECT_LT(r.distance_m, 1e-6);
+  EXPECT_LT(r.filter_final_error_m, 0.05);
+
+  std::map<std::string, std::string> mission;
+  const log::McapReader reader = log::McapReader::Open(r.log_path);
+  for (const log::Metadata& m : reader.metadata()) {
+    if (m.name == "mission") mission = m.metadata;
+  }
+  EXPECT_EQ(mission["scenario"], "two-rovers");
+  EXPECT_EQ(mission["rover"], "1");
+  EXPECT_EQ(mission["rover_name"], "rover_b");
+
+  std::ostringstream summary;
+  PrintMissionSummary(r, summary);
+  const std::string text = summary.str();
+  const std::string last = text.substr(text.rfind("RESULT"));
+  EXPECT_NE(last.find(" rover=1 log=" + r.log_path), std::string::npos) << last;
+}
+
+TEST(MissionTest, ARoverOutsideTheTeamIsRefusedNamingTheCount) {
+  MissionOptions options;
+  options.scenario = "two-rovers";
+  options.rover = 2;
+  try {
+    RunMission(options);
+    FAIL() << "rover 2 of two-rovers ran";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("two-rovers"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("has 2 rovers"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MissionTest, OnlyOtherRoversLogUnderTheirName) {
+  EXPECT_EQ(MissionLogName("short", 0, "rover_a"), "mission-short.mcap");
+  EXPECT_EQ(MissionLogName("two-rovers", 0, "rover_a"), "mission-two-rovers.mcap");
+  EXPECT_EQ(MissionLogName("two-rovers", 1, "rover_b"), "mission-two-rovers-rover_b.mcap");
 }
 
 }  // namespace
