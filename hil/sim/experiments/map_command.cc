@@ -25,6 +25,7 @@
 #include "hil/sim/experiments/loop_replay.h"
 #include "hil/sim/motion/rover_trajectory.h"
 #include "hil/sim/scenario/scenario.h"
+#include "hil/sim/scenario/team_rovers.h"
 #include "mapping/compose/map_composer.h"
 #include "mapping/compose/map_export.h"
 #include "mapping/compose/submap_log.h"
@@ -43,6 +44,9 @@ namespace {
 // What the mission log tells about the run.
 struct MissionFacts {
   std::string scenario;
+  /// Which rover of the scenario the mission simulated (team_rovers.h); 0
+  /// for logs from before team scenarios, which have no "rover".
+  std::size_t rover = 0;
   uint64_t seed = 1;
   Time start;
   bool has_start = false;
@@ -67,6 +71,19 @@ MissionFacts ReadMission(const std::string& path) {
     if (m.name != "mission") continue;
     if (m.metadata.count("scenario")) f.scenario = m.metadata.at("scenario");
     if (m.metadata.count("seed")) f.seed = std::stoull(m.metadata.at("seed"));
+    if (m.metadata.count("rover")) {
+      const std::string& text = m.metadata.at("rover");
+      std::size_t used = 0;
+      try {
+        f.rover = std::stoull(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != text.size()) {
+        throw std::runtime_error(path + ": mission metadata rover=\"" + text +
+                                 "\" is not a rover index");
+      }
+    }
     if (m.metadata.count("lockstep")) lockstep = m.metadata.at("lockstep") == "true";
     if (m.metadata.count("start_ns")) {
       f.start = Time::FromNanoseconds(std::stoll(m.metadata.at("start_ns")));
@@ -512,7 +529,17 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   const sim::Scenario scenario = sim::LoadScenario(
       sim::FindScenario(sim::DefaultScenarioDir(), scenario_name), sim::DefaultSimConfigDir());
   const sim::World world = sim::World::Generate(scenario.world, seed);
-  const sim::RoverTrajectory trajectory(scenario.route, world.terrain);
+  // The ground truth is the trajectory of the rover the mission simulated.
+  const std::size_t rover = o.rover >= 0 ? static_cast<std::size_t>(o.rover) : mission.rover;
+  try {
+    sim::CheckRoverIndex(scenario, rover);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(o.mission_log + ": " + e.what());
+  }
+  const sim::TeamRovers team = sim::MakeTeamRovers(scenario, world);
+  const sim::RoverTrajectory& trajectory = team.trajectories[rover];
+  report << "  ground truth: rover " << rover << " (" << team.names[rover] << ") of "
+         << scenario_name << ", seed " << seed << "\n";
 
   // Frame 0 in the world: the true body pose at initialisation against the
   // filter's estimate then (x, y, z, yaw).
@@ -681,6 +708,9 @@ Subcommand AddMapCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--scenario", options->scenario, "override the scenario recorded in the log");
   cmd->add_option("--seed", options->seed, "override the seed recorded in the log");
+  cmd->add_option("--rover", options->rover,
+                  "override the rover recorded in the log (0: the scenario's route, k: its k-th "
+                  "other rover; logs without one are rover 0)");
   cmd->add_option("--export", options->export_stem,
                   "also write the world-frame map to STEM.bt (octovis) and STEM.ply");
   cmd->add_option("--surface-tolerance-m", options->quality.surface_tolerance_m,

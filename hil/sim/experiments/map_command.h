@@ -4,7 +4,7 @@
 // `rover-sim map`: the quality of the map of a simulated mission against the
 // simulator's ground truth (map_evaluation.h), and the submap bandwidth.
 // Reads the mission's flight log (roverd: frame switches, estimates, the
-// mission's scenario, seed and start time) and mapd's log(s) (submaps),
+// mission's scenario, rover, seed and start time) and mapd's log(s) (submaps),
 // composes the global map in the world frame and scores it.
 
 #include <limits>
@@ -24,9 +24,11 @@ using cli::Subcommand;
 struct MapCommandOptions {
   std::string mission_log;
   std::vector<std::string> mapd_logs;
-  /// Override the scenario and seed recorded in the mission log.
+  /// Override the scenario, seed and rover recorded in the mission log
+  /// (-1: the log's; a log without a rover is rover 0, the scenario's route).
   std::string scenario;
   int64_t seed = -1;
+  int64_t rover = -1;
   /// Also write the world-frame map to STEM.bt and STEM.ply.
   std::string export_stem;
   MapQualityOptions quality;

@@ -13,6 +13,7 @@
 
 #include "core/log/mcap/mcap_reader.h"
 #include "estimator/io/log_replay.h"
+#include "hil/sim/experiments/map_command.h"
 #include "tests/support/temp_dir.h"
 
 namespace rover::sim {
@@ -109,20 +110,25 @@ TEST(MissionTest, LosingTheCanBusLeavesImuAndVo) {
   EXPECT_NE(s.health.find("camera ok"), std::string::npos) << s.health;
 }
 
-// A team scenario run as its second rover: rover_b's own route (it waits
-// at (14, 0) facing west for 45 s), its own log and metadata, and sensors
-// that agree with that truth.
-TEST(MissionTest, RoverOneOfATeamDrivesItsOwnRoute) {
-  const rover::testing::TempDir dir;
+// Six seconds of two-rovers as its second rover, rover_b, which waits at
+// (14, 0) facing west for 45 s while rover_a drives off after 2 s.
+MissionResult RunRoverB(const std::filesystem::path& dir) {
   MissionOptions options;
   options.scenario = "two-rovers";
   options.rover = 1;
   options.seed = 1;
   options.lockstep = true;
-  options.out_dir = dir.path().string();
+  options.out_dir = dir.string();
   options.max_duration_s = 6.0;
   options.images.mode = roverd::ImageLogMode::kNone;
-  const MissionResult r = RunMission(options);
+  return RunMission(options);
+}
+
+// A team scenario run as its second rover: rover_b's own route, its own log
+// and metadata, and sensors that agree with that truth.
+TEST(MissionTest, RoverOneOfATeamDrivesItsOwnRoute) {
+  const rover::testing::TempDir dir;
+  const MissionResult r = RunRoverB(dir.path());
 
   EXPECT_EQ(r.rover, 1u);
   EXPECT_EQ(r.rover_name, "rover_b");
@@ -152,6 +158,39 @@ TEST(MissionTest, RoverOneOfATeamDrivesItsOwnRoute) {
   const std::string text = summary.str();
   const std::string last = text.substr(text.rfind("RESULT"));
   EXPECT_NE(last.find(" rover=1 log=" + r.log_path), std::string::npos) << last;
+}
+
+// `rover-sim map` scores a mission against the trajectory of the rover its
+// log names, not always the scenario's route.
+TEST(MissionTest, MapEvaluationTakesTheLoggedRoversTruth) {
+  const rover::testing::TempDir dir;
+  const MissionResult r = RunRoverB(dir.path());
+  experiments::MapCommandOptions o;
+  o.mission_log = r.log_path;  // no mapd logs: an empty map, but the truth is chosen
+  std::ostringstream as_logged;
+  experiments::EvaluateMission(o, as_logged);
+  EXPECT_NE(as_logged.str().find("ground truth: rover 1 (rover_b) of two-rovers"),
+            std::string::npos)
+      << as_logged.str();
+
+  o.rover = 0;  // --rover overrides the log
+  std::ostringstream overridden;
+  experiments::EvaluateMission(o, overridden);
+  EXPECT_NE(overridden.str().find("ground truth: rover 0 (rover_a) of two-rovers"),
+            std::string::npos)
+      << overridden.str();
+
+  // A scenario without that rover is refused, naming the log.
+  o.rover = -1;
+  o.scenario = "short";
+  try {
+    std::ostringstream report;
+    experiments::EvaluateMission(o, report);
+    FAIL() << "rover 1 of short was scored";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(r.log_path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("has 1 rover"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MissionTest, ARoverOutsideTheTeamIsRefusedNamingTheCount) {
