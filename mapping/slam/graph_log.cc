@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <map>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include "core/log/mcap/mcap_reader.h"
@@ -13,8 +14,11 @@
 namespace rover::mapping {
 namespace {
 
+// Keeps a team message once by (origin, stream, seq).
+using TeamMessageKey = std::tuple<int32_t, uint8_t, uint64_t>;
+
 void ReadOne(const std::string& path, std::set<std::pair<int, uint64_t>>* seen,
-             GraphLogContents* out) {
+             std::set<TeamMessageKey>* seen_team, GraphLogContents* out) {
   log::McapReader reader = log::McapReader::Open(path);
   std::map<uint16_t, std::string> topic_of;
   for (const auto& [id, channel] : reader.channels()) topic_of[id] = channel.topic;
@@ -48,6 +52,15 @@ void ReadOne(const std::string& path, std::set<std::pair<int, uint64_t>>* seen,
     } else if (topic == kGlobalPoseTopic) {
       log::geometry_msgs::PoseWithCovarianceStamped msg;
       if (log::DeserializeMessage(m.data, &msg, &error)) out->last_global_pose = msg;
+    } else if (topic == kTeamSentTopic || topic == kTeamReceivedTopic) {
+      log::rover_msgs::TeamMessage msg;
+      if (!log::DeserializeMessage(m.data, &msg, &error)) {
+        out->problems.push_back(path + ": a team message cannot be decoded: " + error);
+        return true;
+      }
+      if (seen_team->insert({msg.origin, msg.stream, msg.seq}).second) {
+        (topic == kTeamSentTopic ? out->team_sent : out->team_received).push_back(std::move(msg));
+      }
     }
     return true;
   });
@@ -119,7 +132,8 @@ std::size_t PlaceAtGraphOrigins(const log::rover_msgs::SubmapOrigins& graph,
 GraphLogContents ReadGraphLogs(const std::vector<std::string>& paths) {
   GraphLogContents out;
   std::set<std::pair<int, uint64_t>> seen;
-  for (const std::string& path : paths) ReadOne(path, &seen, &out);
+  std::set<TeamMessageKey> seen_team;
+  for (const std::string& path : paths) ReadOne(path, &seen, &seen_team, &out);
   return out;
 }
 

@@ -22,6 +22,10 @@ namespace rover::mapping {
 inline constexpr std::string_view kGraphFactorTopic = "/mapd/graph/factors";
 inline constexpr std::string_view kSubmapOriginsTopic = "/mapd/graph/origins";
 inline constexpr std::string_view kGlobalPoseTopic = "/mapd/global_pose";
+/// The team link's messages (rover_msgs/TeamMessage): this rover's, in the
+/// order it first published them, and the other rovers' as received.
+inline constexpr std::string_view kTeamSentTopic = "/mapd/team/sent";
+inline constexpr std::string_view kTeamReceivedTopic = "/mapd/team/received";
 
 /// What one or more mapd logs hold of the graph.
 struct GraphLogContents {
@@ -35,6 +39,10 @@ struct GraphLogContents {
   std::optional<log::geometry_msgs::PoseWithCovarianceStamped> last_global_pose;
   /// Factors left out and damage, each naming the file and the factor.
   std::vector<std::string> problems;
+  /// The team messages logged (kTeamSentTopic, kTeamReceivedTopic), each
+  /// once by origin, stream and number, in log order.
+  std::vector<log::rover_msgs::TeamMessage> team_sent;
+  std::vector<log::rover_msgs::TeamMessage> team_received;
   uint64_t duplicates = 0;  ///< Factors read again (a later log repeats an earlier one's).
   bool truncated = false;   ///< Some file ends early (e.g. mapd was killed).
 };

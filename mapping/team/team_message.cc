@@ -69,16 +69,19 @@ GraphKey ReadKey(link::wire::Reader* r) {
 }  // namespace
 
 std::vector<uint8_t> EncodeConstraint(const GraphFactorRecord& record) {
+  return EncodeConstraint(ToMsg(record, "robot" + std::to_string(record.a.robot)));
+}
+
+std::vector<uint8_t> EncodeConstraint(const log::rover_msgs::GraphFactor& msg) {
   std::vector<uint8_t> out;
   link::wire::Writer w(&out);
   WriteHead(&w, Kind::kConstraint);
-  const std::vector<std::byte> cdr =
-      log::SerializeMessage(ToMsg(record, "robot" + std::to_string(record.a.robot)));
+  const std::vector<std::byte> cdr = log::SerializeMessage(msg);
   w.Bytes(std::span(reinterpret_cast<const uint8_t*>(cdr.data()), cdr.size()));
   return out;
 }
 
-GraphFactorRecord DecodeConstraint(std::span<const uint8_t> bytes) {
+log::rover_msgs::GraphFactor DecodeConstraintMessage(std::span<const uint8_t> bytes) {
   link::wire::Reader r(bytes);
   ReadHead(&r, Kind::kConstraint);
   const std::span<const uint8_t> cdr = r.Bytes(r.remaining());
@@ -88,10 +91,15 @@ GraphFactorRecord DecodeConstraint(std::span<const uint8_t> bytes) {
     throw TeamMessageError(std::string(Name(Kind::kConstraint)) + ": " + error);
   }
   try {
-    return FromMsg(msg);
+    FromMsg(msg);  // refuses what the graph cannot take
   } catch (const GraphError& e) {
     throw TeamMessageError(std::string(Name(Kind::kConstraint)) + ": " + e.what());
   }
+  return msg;
+}
+
+GraphFactorRecord DecodeConstraint(std::span<const uint8_t> bytes) {
+  return FromMsg(DecodeConstraintMessage(bytes));
 }
 
 std::vector<uint8_t> EncodeMatchClaim(const MatchClaim& claim) {

@@ -37,9 +37,14 @@ class TeamMessageError : public std::runtime_error {
 /// CDR of rover_msgs/GraphFactor), so the receiver's log holds it in the same
 /// form as its own.
 std::vector<uint8_t> EncodeConstraint(const GraphFactorRecord& record);
+/// The same for a factor as it was logged: the receiver gets these bits, so
+/// every rover's graph holds the same numbers.
+std::vector<uint8_t> EncodeConstraint(const log::rover_msgs::GraphFactor& msg);
 /// Throws TeamMessageError for another version or kind, bad CDR, or a
 /// factor FromMsg refuses (naming its id and field).
 GraphFactorRecord DecodeConstraint(std::span<const uint8_t> bytes);
+/// The constraint's message as the sender logged it, checked as above.
+log::rover_msgs::GraphFactor DecodeConstraintMessage(std::span<const uint8_t> bytes);
 
 /// Robot `claimant` matches origins `a` and `b`; no other rover computes or
 /// counts that pair (the thesis's announced match attempts).

@@ -48,6 +48,7 @@ constexpr std::array kAllSchemas = {
     SchemaOf<rover_msgs::SubmapOrigin>(),
     SchemaOf<rover_msgs::SubmapOrigins>(),
     SchemaOf<rover_msgs::TagDetection>(),
+    SchemaOf<rover_msgs::TeamMessage>(),
 };
 
 }  // namespace

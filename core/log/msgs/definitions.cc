@@ -250,6 +250,12 @@ constexpr std::array kOwnTexts = {
             "float64 tilt_rad\n"
             "float64[36] covariance\n"
             "uint32 flipped"},
+    OwnText{"rover_msgs/TeamMessage",
+            "std_msgs/Header header\n"
+            "int32 origin\n"
+            "uint8 stream\n"
+            "uint64 seq\n"
+            "uint8[] data"},
 };
 
 // The primitive types of the ROS 2 interface definition language.

@@ -158,6 +158,21 @@ bool Deserialize(CdrReader& reader, TagDetection* msg) {
          reader.ReadU32("flipped", &msg->flipped);
 }
 
+void Serialize(const TeamMessage& msg, CdrWriter& writer) {
+  Serialize(msg.header, writer);
+  writer.WriteI32(msg.origin);
+  writer.WriteU8(msg.stream);
+  writer.WriteU64(msg.seq);
+  writer.WriteSequenceSize(msg.data.size());
+  writer.WriteU8Array(msg.data);
+}
+
+bool Deserialize(CdrReader& reader, TeamMessage* msg) {
+  return reader.ReadNested("header", &msg->header) && reader.ReadI32("origin", &msg->origin) &&
+         reader.ReadU8("stream", &msg->stream) && reader.ReadU64("seq", &msg->seq) &&
+         reader.ReadU8Sequence("data", &msg->data);
+}
+
 }  // namespace rover_msgs
 
 std::string_view MessageTraits<rover_msgs::LogChannelHealth>::Definition() {
@@ -186,6 +201,10 @@ std::string_view MessageTraits<rover_msgs::SubmapOrigins>::Definition() {
 
 std::string_view MessageTraits<rover_msgs::TagDetection>::Definition() {
   return internal::CachedDefinition<rover_msgs::TagDetection>();
+}
+
+std::string_view MessageTraits<rover_msgs::TeamMessage>::Definition() {
+  return internal::CachedDefinition<rover_msgs::TeamMessage>();
 }
 
 }  // namespace rover::log

@@ -147,6 +147,22 @@ struct TagDetection {
   friend bool operator==(const TagDetection&, const TagDetection&) = default;
 };
 
+/// rover_msgs/msg/TeamMessage: one message of the team link as it travelled
+/// (sent by this rover, or received from another), so that a restarted mapd
+/// carries on where it stopped and the mission can be replayed from the log.
+/// header.stamp: when it was sent or received (CLOCK_MONOTONIC of the
+/// logging rover); `origin`: the robot that published it; `stream` and `seq`
+/// name it within the origin's messages (seq from 1); `data`: its bytes.
+struct TeamMessage {
+  std_msgs::Header header;
+  int32_t origin = 0;
+  uint8_t stream = 0;
+  uint64_t seq = 0;
+  std::vector<uint8_t> data;
+
+  friend bool operator==(const TeamMessage&, const TeamMessage&) = default;
+};
+
 void Serialize(const LogChannelHealth& msg, CdrWriter& writer);
 void Serialize(const LogHealth& msg, CdrWriter& writer);
 void Serialize(const SubmapInfo& msg, CdrWriter& writer);
@@ -161,6 +177,8 @@ bool Deserialize(CdrReader& reader, SubmapOrigin* msg);
 bool Deserialize(CdrReader& reader, SubmapOrigins* msg);
 void Serialize(const TagDetection& msg, CdrWriter& writer);
 bool Deserialize(CdrReader& reader, TagDetection* msg);
+void Serialize(const TeamMessage& msg, CdrWriter& writer);
+bool Deserialize(CdrReader& reader, TeamMessage* msg);
 
 }  // namespace rover_msgs
 
@@ -197,6 +215,12 @@ struct MessageTraits<rover_msgs::SubmapOrigin> {
 template <>
 struct MessageTraits<rover_msgs::SubmapOrigins> {
   static constexpr std::string_view kName = "rover_msgs/msg/SubmapOrigins";
+  static std::string_view Definition();
+};
+
+template <>
+struct MessageTraits<rover_msgs::TeamMessage> {
+  static constexpr std::string_view kName = "rover_msgs/msg/TeamMessage";
   static std::string_view Definition();
 };
 

@@ -194,6 +194,13 @@ class RandomMessages {
     m->distance_m = Real();
     m->tilt_rad = Real();
   }
+  void Fill(rover_msgs::TeamMessage* m) {
+    Fill(&m->header);
+    m->origin = static_cast<int32_t>(rng_());
+    m->stream = static_cast<uint8_t>(Uniform(0, 2));
+    m->seq = rng_();
+    FillOctets(&m->data);
+  }
   void Fill(nav_msgs::Odometry* m) {
     Fill(&m->header);
     m->child_frame_id = FrameId::Truncated(Text(FrameId::kCapacity));
@@ -344,7 +351,7 @@ using AllMessageTypes = ::testing::Types<
     rover_msgs::EstimatorImu, rover_msgs::EstimatorEvent, rover_msgs::EstimatorRelativePose,
     rover_msgs::EstimatorWheelSpeeds, rover_msgs::EstimatorState, rover_msgs::EstimatorFrameSwitch,
     rover_msgs::SubmapInfo, rover_msgs::GraphFactor, rover_msgs::SubmapOrigin,
-    rover_msgs::SubmapOrigins, rover_msgs::TagDetection>;
+    rover_msgs::SubmapOrigins, rover_msgs::TagDetection, rover_msgs::TeamMessage>;
 
 /// gtest names for AllMessageTypes instances: the ROS type name.
 struct MessageTypeName {
