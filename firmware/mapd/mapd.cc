@@ -155,9 +155,14 @@ void MapdOptions::Validate() const {
   switch_noise.Validate();
   submap.Validate();
   loop.Validate();
+  if (team) {
+    if (!slam) throw std::invalid_argument("MapdOptions.team: needs slam (the pose graph)");
+    team->Validate();
+  }
 }
 
-Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
+Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport,
+           std::unique_ptr<link::LinkEndpoint> team_link)
     : options_((options.Validate(), options)),
       trigger_(options.trigger),
       poses_(Subscribe<topics::PoseMsg>(transport, topics::kPoseTopic, options.pose_queue)),
@@ -172,7 +177,11 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport)
       status_(Advertise<topics::MapdStatusMsg>(transport, topics::kMapdStatusTopic, 1)),
       frame_buffer_(std::make_unique<topics::StereoFrameMsg>()),
       history_(options.pose_history),
-      tag_resolver_(options.tag_ambiguity) {
+      tag_resolver_(options.tag_ambiguity),
+      team_link_(std::move(team_link)) {
+  if (options_.team && !team_link_) {
+    throw std::invalid_argument("MapdOptions.team: given, but no team link");
+  }
   if (options_.mapping) {
     std::string error;
     // History 1: roverd published the calibration once, maybe long ago.
@@ -242,6 +251,7 @@ int Mapd::Poll() {
   TryMapPending();
   if (loop_) TakeLoopMatches();
   if (tags_) TakeTagResults();
+  if (team_) TakeTeamConstraints();
   if (slam_) TakeSlamSnapshot();
   if (poses_->HasMissedData()) ++stats_.missed;
   if (frames_->HasMissedData()) ++stats_.missed;
@@ -321,6 +331,7 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
     return;
   }
   ++stats_.poses;
+  newest_stamp_ns_ = std::max(newest_stamp_ns_, pose.stamp_ns);
   history_.Add(PoseOf(pose));
   // Before the filter has initialised there is no frame to map in, and it
   // would refuse a switch.
@@ -587,44 +598,63 @@ void Mapd::LoadResumeCandidate() {
 void Mapd::DecideResume(const topics::FrameSwitchMsg* record) {
   if (resume_decided_) return;
   resume_decided_ = true;
-  if (!resume_candidate_) return;
+  if (!resume_candidate_) {
+    StartTeam(nullptr);
+    return;
+  }
   // The same mission iff roverd's switch history holds a switch the earlier
-  // graph has: same frames, same stamp to the nanosecond.
+  // graph has: same frames, same stamp to the nanosecond. Only this rover's
+  // factors count; the log also holds what the team sent.
+  const auto own = [this](const mapping::GraphFactorRecord& f) {
+    return f.a.robot == options_.robot_id;
+  };
   bool same_mission = false;
   for (const mapping::GraphFactorRecord& f : resume_candidate_->factors) {
-    same_mission =
-        same_mission || (record != nullptr && f.kind == mapping::FactorKind::kFrameSwitch &&
-                         f.a.index == record->old_frame_id && f.stamp_ns == record->stamp_ns);
+    same_mission = same_mission ||
+                   (record != nullptr && own(f) && f.kind == mapping::FactorKind::kFrameSwitch &&
+                    f.a.index == record->old_frame_id && f.stamp_ns == record->stamp_ns);
   }
   if (!same_mission) {
     std::fprintf(stderr, "mapd: %s is not this mission's (no switch in common): a new graph\n",
                  resume_path_.c_str());
     resume_candidate_.reset();
+    StartTeam(nullptr);
     return;
   }
   std::fprintf(stderr, "mapd: resuming the pose graph of %s (%zu factors)\n", resume_path_.c_str(),
                resume_candidate_->factors.size());
   for (std::size_t k = 0; k < resume_candidate_->factors.size(); ++k) {
     const mapping::GraphFactorRecord& f = resume_candidate_->factors[k];
-    if (f.kind == mapping::FactorKind::kPrior) {
+    if (own(f) && f.kind == mapping::FactorKind::kPrior) {
       prior_added_ = true;
       prior_frame_ = f.a.index;
     }
-    if (f.kind == mapping::FactorKind::kFrameSwitch) switched_frames_.insert(f.a.index);
-    next_factor_id_ = std::max(next_factor_id_, f.id + 1);
+    if (own(f) && f.kind == mapping::FactorKind::kFrameSwitch) switched_frames_.insert(f.a.index);
+    if (own(f)) next_factor_id_ = std::max(next_factor_id_, f.id + 1);
     LogAndSubmit(resume_candidate_->messages[k]);  // this log holds the whole graph again
   }
   stats_.graph_factors_resumed = resume_candidate_->factors.size();
+  StartTeam(&*resume_candidate_);
   resume_candidate_.reset();
+}
+
+void Mapd::StartTeam(const mapping::GraphLogContents* resumed) {
+  if (!options_.team) return;
+  team_ = std::make_unique<TeamExchange>(options_.robot_id, std::move(team_link_), *options_.team,
+                                         archive_.get(), resumed);
+}
+
+void Mapd::TakeTeamConstraints() {
+  for (const log::rover_msgs::GraphFactor& msg : team_->Take(newest_stamp_ns_)) {
+    LogAndSubmit(msg);
+  }
 }
 
 void Mapd::AddFactor(mapping::GraphFactorRecord factor) {
   factor.id = next_factor_id_++;
-  LogAndSubmit(factor);
-}
-
-void Mapd::LogAndSubmit(const mapping::GraphFactorRecord& factor) {
-  LogAndSubmit(mapping::ToMsg(factor, "graph/" + options_.robot_name));
+  const log::rover_msgs::GraphFactor msg = mapping::ToMsg(factor, "graph/" + options_.robot_name);
+  LogAndSubmit(msg);
+  if (team_) team_->Share(msg, factor.stamp_ns);
 }
 
 void Mapd::LogAndSubmit(const log::rover_msgs::GraphFactor& msg) {
@@ -867,6 +897,11 @@ void Mapd::TakeSlamSnapshot() {
   if (snap.T_world_body) {
     PublishGlobalPose(snap);
     if (archive_) LogGlobalPose(snap);
+    if (team_) {
+      team_->SetHeartbeat({.stamp_ns = snap.global_pose_stamp_ns,
+                           .submap = snap.global_pose_frame_id,
+                           .T_world_body = *snap.T_world_body});
+    }
   }
 }
 
@@ -930,11 +965,13 @@ void Mapd::Shutdown() {
     tags_->Stop();
     ApplyTagDecisions(tag_resolver_.Expire(newest_tag_stamp_ns_, true));
   }
+  if (team_) TakeTeamConstraints();
   if (slam_) {
     HandLatestPose();  // the run's final global pose is the last estimate's
     slam_->Flush();
     TakeSlamSnapshot();
   }
+  if (team_) team_->Stop();
   if (!archive_) return;
   FinishMappingSubmap();
   const MapdBandwidth b = Bandwidth();
@@ -981,6 +1018,18 @@ void Mapd::Shutdown() {
     graph["tags_resolved"] = std::to_string(stats_.tags_resolved);
     graph["tags_inflated"] = std::to_string(stats_.tags_inflated);
     graph["tags_unresolved"] = std::to_string(stats_.tags_unresolved);
+  }
+  if (team_) {
+    const TeamExchangeStats t = team_->Stats();
+    graph["team_robot_id"] = std::to_string(options_.robot_id);
+    graph["team_constraints_shared"] = std::to_string(t.constraints_shared);
+    graph["team_constraints_received"] = std::to_string(t.constraints_received);
+    graph["team_constraints_refused"] = std::to_string(t.constraints_refused);
+    graph["team_undecodable"] = std::to_string(t.worker.undecodable);
+    graph["team_link_bytes_sent"] = std::to_string(t.worker.link.sent_bytes);
+    graph["team_link_bytes_received"] = std::to_string(t.worker.link.received_bytes);
+    graph["team_duplicate_fragments"] = std::to_string(t.worker.sync.duplicate_fragments);
+    graph["team_refused_datagrams"] = std::to_string(t.worker.sync.refused_datagrams);
   }
   std::map<std::string, std::string> statistics = {
       {"submaps", std::to_string(stats_.submaps_archived)},
@@ -1105,6 +1154,7 @@ std::string Mapd::Summary() const {
                   static_cast<unsigned long long>(stats_.robot_tags_seen));
     out += text;
   }
+  if (team_) out += team_->Summary();
   if (first_memory_ && last_memory_) {
     const auto mb = [](uint64_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); };
     const auto kb_mb = [](uint64_t kb) { return static_cast<double>(kb) / 1024.0; };

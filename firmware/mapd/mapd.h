@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/ipc/transport.h"
+#include "core/link/link_endpoint.h"
 #include "core/time/time.h"
 #include "firmware/mapd/local_mapper.h"
 #include "firmware/mapd/loop_closer.h"
@@ -34,6 +35,7 @@
 #include "firmware/mapd/slam_worker.h"
 #include "firmware/mapd/submap_trigger.h"
 #include "firmware/mapd/tag_worker.h"
+#include "firmware/mapd/team_exchange.h"
 #include "firmware/runtime/health/process_memory.h"
 #include "firmware/runtime/topics/rover_topics.h"
 #include "mapping/slam/frame_switch_noise.h"
@@ -108,6 +110,12 @@ struct MapdOptions {
   /// Deciding ambiguous detections by the tag's other sightings.
   mapping::TagAmbiguityOptions tag_ambiguity{};
 
+  /// Multi-robot SLAM (needs slam): this rover's graph factors go to the
+  /// other rovers over the team link given to the constructor, and theirs
+  /// join this rover's graph; the graph's robot id is robot_id.
+  /// nullopt: alone.
+  std::optional<TeamWorkerOptions> team{};
+
   /// Throws std::invalid_argument naming the key.
   void Validate() const;
 };
@@ -178,9 +186,13 @@ struct MapdBandwidth {
 
 class Mapd {
  public:
-  /// Creates the endpoints on `transport`. Throws std::runtime_error naming a
-  /// topic the transport refused, std::invalid_argument for bad options.
-  Mapd(const MapdOptions& options, ipc::Transport* transport);
+  /// Creates the endpoints on `transport`. With options.team, `team_link` is
+  /// this rover's end of the team link (robot options.robot_id); the team
+  /// thread starts once mapd knows whether it resumes an earlier log. Throws
+  /// std::runtime_error naming a topic the transport refused,
+  /// std::invalid_argument for bad options or a team without a link.
+  Mapd(const MapdOptions& options, ipc::Transport* transport,
+       std::unique_ptr<link::LinkEndpoint> team_link = nullptr);
   ~Mapd();
   Mapd(const Mapd&) = delete;
   Mapd& operator=(const Mapd&) = delete;
@@ -197,6 +209,8 @@ class Mapd {
   LoopCloserStats loop_stats() const { return loop_ ? loop_->Stats() : LoopCloserStats{}; }
   /// The tag thread's counters (empty with tags off).
   TagWorkerStats tag_stats() const { return tags_ ? tags_->Stats() : TagWorkerStats{}; }
+  /// The team exchange's counters (empty alone or before it started).
+  TeamExchangeStats team_stats() const { return team_ ? team_->Stats() : TeamExchangeStats{}; }
   /// The latest graph snapshot (update 0 without slam).
   SlamSnapshot slam_snapshot() const { return slam_ ? slam_->Latest() : SlamSnapshot{}; }
 
@@ -229,9 +243,9 @@ class Mapd {
   /// Archives the mapping submap (log, composition) and forgets it.
   void FinishMappingSubmap();
   void LogTraversability(int64_t stamp_ns);
-  /// Logs `factor` (with the next id) and hands its logged form to the graph.
+  /// Logs `factor` (with the next id), hands its logged form to the graph
+  /// and shares it with the team.
   void AddFactor(mapping::GraphFactorRecord factor);
-  void LogAndSubmit(const mapping::GraphFactorRecord& factor);
   void LogAndSubmit(const log::rover_msgs::GraphFactor& msg);
   /// Reads the graph of the newest earlier mapd log beside ours.
   void LoadResumeCandidate();
@@ -239,6 +253,11 @@ class Mapd {
   /// earlier log's graph if roverd's switch history shows it is this
   /// mission's (a restart), or starts a new one.
   void DecideResume(const runtime::topics::FrameSwitchMsg* record);
+  /// Starts the team exchange (with options.team) once the resume is
+  /// decided: a resumed log's team messages are what this rover already has.
+  void StartTeam(const mapping::GraphLogContents* resumed);
+  /// Adds the other rovers' constraints that arrived to the graph.
+  void TakeTeamConstraints();
   /// Anchors the graph at `frame_id` (once): the world frame of this rover.
   void EnsurePrior(uint32_t frame_id, int64_t stamp_ns);
   /// Takes a new graph snapshot: moves the composed submaps, logs it.
@@ -301,6 +320,9 @@ class Mapd {
   std::unique_ptr<TagWorker> tags_;
   std::set<int> unknown_tag_ids_;  ///< reported once each
   mapping::TagAmbiguityResolver tag_resolver_;
+  std::unique_ptr<link::LinkEndpoint> team_link_;  ///< until the team starts
+  std::unique_ptr<TeamExchange> team_;
+  int64_t newest_stamp_ns_ = 0;  ///< of any estimate: the team messages' log time
   /// Ambiguous observations waiting for the resolver, by key.
   std::map<uint64_t, std::pair<TagSighting, mapping::TagObservation>> waiting_tags_;
   uint64_t next_tag_key_ = 1;

@@ -15,7 +15,9 @@
 #include <thread>
 
 #include "core/ipc/iceoryx_transport.h"
+#include "core/link/dds/dds_link.h"
 #include "firmware/mapd/mapd.h"
+#include "firmware/mapd/team_config.h"
 #include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/health/systemd_notifier.h"
 #include "mapping/tags/tag_observer.h"
@@ -111,7 +113,30 @@ int main(int argc, char** argv) {
   app.add_flag("--match-6d", match_6d,
                "match submaps with the 6D baseline (6D RANSAC and ICP) instead of the 4D "
                "matcher that uses the submaps' gravity alignment");
+  std::string team_file;
+  app.add_option("--team", team_file,
+                 "team file (YAML: DDS domain, each robot's id, name, address and radio "
+                 "interface, the link's byte budget; see firmware/mapd/team_config.h): this "
+                 "rover shares its graph's factors with the team over Cyclone DDS and adds theirs "
+                 "to its own graph. Needs --robot-id");
+  app.add_option("--robot-id", options.robot_id,
+                 "this rover's id in the pose graph and in the team file")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  std::optional<rover::mapd::TeamConfig> team;
+  if (!team_file.empty()) {
+    try {
+      const rover::ConfigNode root = rover::ConfigNode::LoadFile(team_file);
+      team = rover::mapd::TeamConfig::Load(root, options.robot_id);
+      root.CheckNoUnknownKeysRecursive();
+      options.team = team->worker;
+      if (app.get_option("--robot")->count() == 0) options.robot_name = team->Self().name;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "mapd: team file: %s\n", e.what());
+      return 78;  // EX_CONFIG
+    }
+  }
   if (!config.empty()) {
     try {
       const auto board = rover::runtime::BoardConfig::LoadFile(config);
@@ -133,7 +158,7 @@ int main(int argc, char** argv) {
       if (tags_file.empty()) tags_file = board.mapd.tags;
       if (options.tag_tables_dir.empty()) options.tag_tables_dir = board.mapd.tag_tables;
       options.build_missing_tag_tables = board.mapd.build_missing_tag_tables;
-      if (app.get_option("--robot")->count() == 0) options.robot_name = board.board.name;
+      if (app.get_option("--robot")->count() == 0 && !team) options.robot_name = board.board.name;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "mapd: %s\n", e.what());
       return 78;  // EX_CONFIG: systemd does not restart a bad configuration
@@ -167,7 +192,17 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "mapd: %s\n", error.c_str());
       return 2;
     }
-    rover::mapd::Mapd mapd(options, transport.get());
+    std::unique_ptr<rover::link::LinkEndpoint> team_link;
+    if (team) {
+      team_link = std::make_unique<rover::link::DdsLink>(
+          rover::link::DdsLinkOptions{.self = static_cast<rover::link::RobotId>(team->self),
+                                      .domain_id = team->domain_id,
+                                      .config_xml = team->DdsConfigXml()});
+      std::fprintf(stderr, "mapd: team: robot %d (%s) on %s, DDS domain %u, %zu peers\n",
+                   team->self, team->Self().name.c_str(), team->Self().interface_name.c_str(),
+                   team->domain_id, team->PeerAddresses().size());
+    }
+    rover::mapd::Mapd mapd(options, transport.get(), std::move(team_link));
     std::fprintf(stderr, "mapd: running (pid %d)\n", static_cast<int>(::getpid()));
     // Under systemd (Type=notify, WatchdogSec=): ready now, and alive as
     // long as this loop turns.

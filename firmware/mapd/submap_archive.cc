@@ -117,6 +117,13 @@ void SubmapArchive::LogDiagnostics(const log::diagnostic_msgs::DiagnosticArray& 
               diagnostics);
 }
 
+void SubmapArchive::LogTeamMessage(std::string_view topic,
+                                   const log::rover_msgs::TeamMessage& message) {
+  if (!log_) return;
+  log_->Write(topic, log::FromRosTime(message.header.stamp).nanoseconds(), message);
+  log_->Flush();
+}
+
 void SubmapArchive::LogGlobalPose(const log::geometry_msgs::PoseWithCovarianceStamped& pose) {
   if (!log_) return;
   log_->Write(mapping::kGlobalPoseTopic, log::FromRosTime(pose.header.stamp).nanoseconds(), pose);

@@ -71,6 +71,9 @@ class SubmapArchive {
   void LogTagDetection(const log::rover_msgs::TagDetection& detection);
   /// Logs mapd's own diagnostics (its memory) on /diagnostics.
   void LogDiagnostics(const log::diagnostic_msgs::DiagnosticArray& diagnostics);
+  /// Logs one message of the team link on `topic` (mapping::kTeamSentTopic
+  /// or kTeamReceivedTopic) and flushes it (a crash keeps it).
+  void LogTeamMessage(std::string_view topic, const log::rover_msgs::TeamMessage& message);
   /// Logs the global pose after an update.
   void LogGlobalPose(const log::geometry_msgs::PoseWithCovarianceStamped& pose);
   /// Places the submaps at the pose graph's origins (T_world_frame by local

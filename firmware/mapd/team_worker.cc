@@ -55,6 +55,12 @@ void TeamWorker::PublishConstraint(const mapping::GraphFactorRecord& record) {
   outbox_.emplace_back(mapping::TeamStream::kConstraints, std::move(bytes));
 }
 
+void TeamWorker::PublishConstraint(const log::rover_msgs::GraphFactor& msg) {
+  std::vector<uint8_t> bytes = mapping::EncodeConstraint(msg);
+  const std::lock_guard lock(mutex_);
+  outbox_.emplace_back(mapping::TeamStream::kConstraints, std::move(bytes));
+}
+
 void TeamWorker::PublishClaim(const mapping::MatchClaim& claim) {
   std::vector<uint8_t> bytes = mapping::EncodeMatchClaim(claim);
   const std::lock_guard lock(mutex_);
@@ -92,12 +98,14 @@ void TeamWorker::Deliver(const link::TeamMessage& m) {
   try {
     switch (record.stream) {
       case mapping::TeamStream::kConstraints: {
-        mapping::GraphFactorRecord f = mapping::DecodeConstraint(m.bytes);
+        log::rover_msgs::GraphFactor msg = mapping::DecodeConstraintMessage(m.bytes);
+        mapping::GraphFactorRecord f = mapping::FromMsg(msg);
         if (f.a.robot != static_cast<int>(m.origin)) {
           throw mapping::TeamMessageError("a constraint of robot " + std::to_string(f.a.robot) +
                                           " from robot " + std::to_string(m.origin));
         }
         inbox_.constraints.push_back(std::move(f));
+        inbox_.constraint_messages.push_back(std::move(msg));
         break;
       }
       case mapping::TeamStream::kMatchClaims:

@@ -59,6 +59,8 @@ struct TeamBacklog {
 struct TeamInbox {
   std::vector<TeamRecord> records;  ///< every message, as received (to log)
   std::vector<mapping::GraphFactorRecord> constraints;
+  /// The same constraints as their senders logged them (same order).
+  std::vector<log::rover_msgs::GraphFactor> constraint_messages;
   std::vector<mapping::MatchClaim> claims;
   std::vector<TeamRecord> submaps;
 };
@@ -84,6 +86,8 @@ class TeamWorker {
 
   /// Queue for the team; never blocks on the link.
   void PublishConstraint(const mapping::GraphFactorRecord& record);
+  /// A constraint as this rover logged it (the team gets the same bits).
+  void PublishConstraint(const log::rover_msgs::GraphFactor& msg);
   void PublishClaim(const mapping::MatchClaim& claim);
   void PublishSubmap(std::vector<uint8_t> bytes);
   void SetHeartbeat(const mapping::TeamHeartbeat& heartbeat);

@@ -1,0 +1,164 @@
+#include "firmware/mapd/team_exchange.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
+#include "core/log/msgs/message_traits.h"
+#include "firmware/mapd/submap_archive.h"
+#include "mapping/team/team_message.h"
+
+namespace rover::mapd {
+namespace {
+
+TeamRecord RecordOf(const log::rover_msgs::TeamMessage& m) {
+  return {static_cast<link::RobotId>(m.origin), static_cast<mapping::TeamStream>(m.stream), m.seq,
+          m.data};
+}
+
+// The backlog a restarted mapd hands the protocol: what its log says it had.
+TeamBacklog BacklogOf(int self, const mapping::GraphLogContents* resumed) {
+  TeamBacklog backlog;
+  if (resumed == nullptr) return backlog;
+  for (const log::rover_msgs::TeamMessage& m : resumed->team_sent) {
+    if (m.origin != self) {
+      throw std::invalid_argument("mapd team: the previous log's sent messages are robot " +
+                                  std::to_string(m.origin) + "'s, this rover is robot " +
+                                  std::to_string(self));
+    }
+    backlog.own.push_back(RecordOf(m));
+  }
+  for (const log::rover_msgs::TeamMessage& m : resumed->team_received) {
+    backlog.received.push_back(RecordOf(m));
+  }
+  return backlog;
+}
+
+}  // namespace
+
+TeamExchange::TeamExchange(int self, std::unique_ptr<link::LinkEndpoint> endpoint,
+                           const TeamWorkerOptions& options, SubmapArchive* archive,
+                           const mapping::GraphLogContents* resumed)
+    : self_(self), archive_(archive) {
+  if (!endpoint) throw std::invalid_argument("mapd team: no link endpoint");
+  if (endpoint->self() != static_cast<link::RobotId>(self)) {
+    throw std::invalid_argument("mapd team: the link endpoint is robot " +
+                                std::to_string(endpoint->self()) + "'s, this rover is robot " +
+                                std::to_string(self));
+  }
+  TeamBacklog backlog = BacklogOf(self, resumed);
+  for (const TeamRecord& r : backlog.own) {
+    uint64_t& last = sent_[r.stream];
+    last = std::max(last, r.seq);
+    Log(mapping::kTeamSentTopic, self, r.stream, r.seq, r.bytes, 0);
+  }
+  for (const TeamRecord& r : backlog.received) {
+    Log(mapping::kTeamReceivedTopic, static_cast<int32_t>(r.origin), r.stream, r.seq, r.bytes, 0);
+  }
+  stats_.messages_resumed = backlog.own.size() + backlog.received.size();
+  worker_ = std::make_unique<TeamWorker>(std::move(endpoint), options, backlog);
+  for (const link::RobotId id : options.sync.team) {
+    if (static_cast<int>(id) != self) team_.insert(static_cast<int>(id));
+  }
+}
+
+TeamExchange::~TeamExchange() { Stop(); }
+
+void TeamExchange::Stop() { worker_->Stop(); }
+
+void TeamExchange::Log(std::string_view topic, int32_t origin, mapping::TeamStream stream,
+                       uint64_t seq, const std::vector<uint8_t>& bytes, int64_t stamp_ns) {
+  if (archive_ == nullptr) return;
+  log::rover_msgs::TeamMessage m;
+  m.header.stamp = log::ToRosTime(Time::FromNanoseconds(stamp_ns));
+  m.header.frame_id = log::FrameId::Truncated("team");
+  m.origin = origin;
+  m.stream = static_cast<uint8_t>(stream);
+  m.seq = seq;
+  m.data = bytes;
+  archive_->LogTeamMessage(topic, m);
+}
+
+void TeamExchange::Share(const log::rover_msgs::GraphFactor& msg, int64_t stamp_ns) {
+  if (msg.kind == log::rover_msgs::GraphFactor::kPrior) return;
+  worker_->PublishConstraint(msg);
+  const uint64_t seq = ++sent_[mapping::TeamStream::kConstraints];
+  Log(mapping::kTeamSentTopic, self_, mapping::TeamStream::kConstraints, seq,
+      mapping::EncodeConstraint(msg), stamp_ns);
+  ++stats_.constraints_shared;
+}
+
+std::string TeamExchange::Check(const mapping::GraphFactorRecord& record) const {
+  const auto known = [this](const mapping::GraphKey& key) {
+    return key.type == mapping::GraphKey::Type::kLandmark || team_.empty() ||
+           team_.count(key.robot) > 0 || key.robot == self_;
+  };
+  if (record.kind == mapping::FactorKind::kPrior) {
+    return "a prior (each rover anchors only its own map)";
+  }
+  if (record.a.robot == self_) return "it is this rover's own (" + record.a.ToString() + ")";
+  for (const std::optional<mapping::GraphKey>& key : {std::optional(record.a), record.b}) {
+    if (key && !known(*key)) {
+      return "it names " + key->ToString() + " of robot " + std::to_string(key->robot) +
+             ", which is not in the team";
+    }
+  }
+  return {};
+}
+
+std::vector<log::rover_msgs::GraphFactor> TeamExchange::Take(int64_t stamp_ns) {
+  TeamInbox inbox = worker_->Take();
+  for (const TeamRecord& r : inbox.records) {
+    Log(mapping::kTeamReceivedTopic, static_cast<int32_t>(r.origin), r.stream, r.seq, r.bytes,
+        stamp_ns);
+  }
+  std::vector<log::rover_msgs::GraphFactor> out;
+  for (std::size_t k = 0; k < inbox.constraints.size(); ++k) {
+    const std::string refusal = Check(inbox.constraints[k]);
+    if (!refusal.empty()) {
+      ++stats_.constraints_refused;
+      stats_.last_refusal = "constraint " + inbox.constraints[k].Describe() + " (id " +
+                            std::to_string(inbox.constraints[k].id) + ") refused: " + refusal;
+      std::fprintf(stderr, "mapd: team: %s\n", stats_.last_refusal.c_str());
+      continue;
+    }
+    ++stats_.constraints_received;
+    out.push_back(std::move(inbox.constraint_messages[k]));
+  }
+  return out;
+}
+
+void TeamExchange::SetHeartbeat(const mapping::TeamHeartbeat& heartbeat) {
+  worker_->SetHeartbeat(heartbeat);
+}
+
+TeamExchangeStats TeamExchange::Stats() const {
+  TeamExchangeStats s = stats_;
+  s.worker = worker_->Stats();
+  return s;
+}
+
+std::string TeamExchange::Summary() const {
+  const TeamExchangeStats s = Stats();
+  char text[400];
+  std::snprintf(text, sizeof(text),
+                "  team (robot %d): %llu constraints shared, %llu received, %llu refused; %zu "
+                "peers; link %llu bytes sent, %llu received; %llu messages undecodable; %llu "
+                "taken over from the previous log\n",
+                self_, static_cast<unsigned long long>(s.constraints_shared),
+                static_cast<unsigned long long>(s.constraints_received),
+                static_cast<unsigned long long>(s.constraints_refused), s.worker.peers.size(),
+                static_cast<unsigned long long>(s.worker.link.sent_bytes),
+                static_cast<unsigned long long>(s.worker.link.received_bytes),
+                static_cast<unsigned long long>(s.worker.undecodable),
+                static_cast<unsigned long long>(s.messages_resumed));
+  std::string out = text;
+  if (!s.last_refusal.empty()) out += "    last refused: " + s.last_refusal + "\n";
+  if (!s.worker.last_decode_error.empty()) {
+    out += "    last undecodable: " + s.worker.last_decode_error + "\n";
+  }
+  return out;
+}
+
+}  // namespace rover::mapd

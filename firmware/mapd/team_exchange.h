@@ -1,0 +1,87 @@
+#ifndef ROVER_FIRMWARE_MAPD_TEAM_EXCHANGE_H_
+#define ROVER_FIRMWARE_MAPD_TEAM_EXCHANGE_H_
+
+// mapd's side of the team: it shares this rover's graph factors with the
+// other rovers (through the TeamWorker's thread), takes theirs in, checked,
+// and logs every message both ways (rover_msgs/TeamMessage on
+// /mapd/team/sent and /mapd/team/received). The log is what a restarted mapd
+// starts from: its own messages get the same numbers again and the others'
+// are held again, so the team resends only what it missed, and nothing
+// arrives twice.
+//
+// A received constraint joins this rover's graph only if every robot it
+// names is in the team and it is not one of this rover's own; anything else
+// is refused, counted, and the reason kept for the summary.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "core/link/link_endpoint.h"
+#include "firmware/mapd/team_worker.h"
+#include "mapping/slam/graph_log.h"
+
+namespace rover::mapd {
+
+class SubmapArchive;
+
+/// Counters of the team exchange.
+struct TeamExchangeStats {
+  uint64_t constraints_shared = 0;    ///< this rover's factors handed to the team
+  uint64_t constraints_received = 0;  ///< the others' factors added to this graph
+  uint64_t constraints_refused = 0;   ///< received but refused (see last_refusal)
+  uint64_t messages_resumed = 0;      ///< taken over from the previous mapd's log
+  std::string last_refusal;
+  TeamWorkerStats worker;
+};
+
+class TeamExchange {
+ public:
+  /// Starts the team thread on `endpoint` as robot `self`. `archive` (may be
+  /// null) logs every message. `resumed` (may be null) is this mission's
+  /// earlier mapd log: its team messages are logged again and handed to the
+  /// protocol as what this rover already has. Throws std::invalid_argument
+  /// for invalid options, an endpoint of another robot id, or a resumed log
+  /// whose own messages are another robot's.
+  TeamExchange(int self, std::unique_ptr<link::LinkEndpoint> endpoint,
+               const TeamWorkerOptions& options, SubmapArchive* archive,
+               const mapping::GraphLogContents* resumed);
+  ~TeamExchange();
+  TeamExchange(const TeamExchange&) = delete;
+  TeamExchange& operator=(const TeamExchange&) = delete;
+
+  /// Shares one factor of this rover's graph, as logged (priors stay home:
+  /// each rover anchors its own map). `stamp_ns` is the log time.
+  void Share(const log::rover_msgs::GraphFactor& msg, int64_t stamp_ns);
+  /// The other rovers' constraints that arrived since the last call, logged
+  /// and checked, in arrival order.
+  std::vector<log::rover_msgs::GraphFactor> Take(int64_t stamp_ns);
+  /// This rover's latest global pose for the others.
+  void SetHeartbeat(const mapping::TeamHeartbeat& heartbeat);
+
+  TeamExchangeStats Stats() const;
+  /// One line for mapd's summary.
+  std::string Summary() const;
+  /// Stops the team thread (idempotent).
+  void Stop();
+
+ private:
+  void Log(std::string_view topic, int32_t origin, mapping::TeamStream stream, uint64_t seq,
+           const std::vector<uint8_t>& bytes, int64_t stamp_ns);
+  /// Empty if `record` may join the graph, else why not.
+  std::string Check(const mapping::GraphFactorRecord& record) const;
+
+  const int self_;
+  SubmapArchive* archive_;
+  std::unique_ptr<TeamWorker> worker_;
+  std::map<mapping::TeamStream, uint64_t> sent_;  ///< last number per stream
+  std::set<int> team_;                            ///< the other robots' ids (empty: any)
+  TeamExchangeStats stats_;
+};
+
+}  // namespace rover::mapd
+
+#endif  // ROVER_FIRMWARE_MAPD_TEAM_EXCHANGE_H_
