@@ -1028,6 +1028,7 @@ void Mapd::Shutdown() {
     graph["team_undecodable"] = std::to_string(t.worker.undecodable);
     graph["team_link_bytes_sent"] = std::to_string(t.worker.link.sent_bytes);
     graph["team_link_bytes_received"] = std::to_string(t.worker.link.received_bytes);
+    graph["team_link_bytes_per_s"] = std::to_string(t.link_bytes_per_s);
     graph["team_duplicate_fragments"] = std::to_string(t.worker.sync.duplicate_fragments);
     graph["team_refused_datagrams"] = std::to_string(t.worker.sync.refused_datagrams);
   }

@@ -136,23 +136,26 @@ void TeamExchange::SetHeartbeat(const mapping::TeamHeartbeat& heartbeat) {
 TeamExchangeStats TeamExchange::Stats() const {
   TeamExchangeStats s = stats_;
   s.worker = worker_->Stats();
+  const double wall_s = (Time::Now() - started_).ToSeconds();
+  if (wall_s > 0.0) s.link_bytes_per_s = static_cast<double>(s.worker.link.sent_bytes) / wall_s;
   return s;
 }
 
 std::string TeamExchange::Summary() const {
   const TeamExchangeStats s = Stats();
   char text[400];
-  std::snprintf(text, sizeof(text),
-                "  team (robot %d): %llu constraints shared, %llu received, %llu refused; %zu "
-                "peers; link %llu bytes sent, %llu received; %llu messages undecodable; %llu "
-                "taken over from the previous log\n",
-                self_, static_cast<unsigned long long>(s.constraints_shared),
-                static_cast<unsigned long long>(s.constraints_received),
-                static_cast<unsigned long long>(s.constraints_refused), s.worker.peers.size(),
-                static_cast<unsigned long long>(s.worker.link.sent_bytes),
-                static_cast<unsigned long long>(s.worker.link.received_bytes),
-                static_cast<unsigned long long>(s.worker.undecodable),
-                static_cast<unsigned long long>(s.messages_resumed));
+  std::snprintf(
+      text, sizeof(text),
+      "  team (robot %d): %llu constraints shared, %llu received, %llu refused; %zu "
+      "peers; link %llu bytes sent (%.0f B/s), %llu received; %llu messages undecodable; %llu "
+      "taken over from the previous log\n",
+      self_, static_cast<unsigned long long>(s.constraints_shared),
+      static_cast<unsigned long long>(s.constraints_received),
+      static_cast<unsigned long long>(s.constraints_refused), s.worker.peers.size(),
+      static_cast<unsigned long long>(s.worker.link.sent_bytes), s.link_bytes_per_s,
+      static_cast<unsigned long long>(s.worker.link.received_bytes),
+      static_cast<unsigned long long>(s.worker.undecodable),
+      static_cast<unsigned long long>(s.messages_resumed));
   std::string out = text;
   if (!s.last_refusal.empty()) out += "    last refused: " + s.last_refusal + "\n";
   if (!s.worker.last_decode_error.empty()) {

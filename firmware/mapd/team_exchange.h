@@ -34,6 +34,9 @@ struct TeamExchangeStats {
   uint64_t constraints_received = 0;  ///< the others' factors added to this graph
   uint64_t constraints_refused = 0;   ///< received but refused (see last_refusal)
   uint64_t messages_resumed = 0;      ///< taken over from the previous mapd's log
+  /// Bytes this rover sent on the link per second of wall time since the
+  /// exchange started (the radio's view: summaries, resends and all).
+  double link_bytes_per_s = 0.0;
   std::string last_refusal;
   TeamWorkerStats worker;
 };
@@ -79,6 +82,7 @@ class TeamExchange {
   std::unique_ptr<TeamWorker> worker_;
   std::map<mapping::TeamStream, uint64_t> sent_;  ///< last number per stream
   std::set<int> team_;                            ///< the other robots' ids (empty: any)
+  Time started_ = Time::Now();
   TeamExchangeStats stats_;
 };
 
