@@ -177,6 +177,7 @@ Mapd::Mapd(const MapdOptions& options, ipc::Transport* transport,
       status_(Advertise<topics::MapdStatusMsg>(transport, topics::kMapdStatusTopic, 1)),
       frame_buffer_(std::make_unique<topics::StereoFrameMsg>()),
       history_(options.pose_history),
+      team_history_(options.team ? options.team_pose_history : 1),
       tag_resolver_(options.tag_ambiguity),
       team_link_(std::move(team_link)) {
   if (options_.team && !team_link_) {
@@ -251,7 +252,10 @@ int Mapd::Poll() {
   TryMapPending();
   if (loop_) TakeLoopMatches();
   if (tags_) TakeTagResults();
-  if (team_) TakeTeamConstraints();
+  if (team_) {
+    TakeTeamConstraints();
+    if (!waiting_detections_.empty()) RetryWaitingDetections(false);
+  }
   if (slam_) TakeSlamSnapshot();
   if (poses_->HasMissedData()) ++stats_.missed;
   if (frames_->HasMissedData()) ++stats_.missed;
@@ -333,6 +337,10 @@ void Mapd::OnPose(const topics::PoseMsg& pose) {
   ++stats_.poses;
   newest_stamp_ns_ = std::max(newest_stamp_ns_, pose.stamp_ns);
   history_.Add(PoseOf(pose));
+  if (team_ && pose.stamp_ns - last_team_history_ns_ >= options_.team_pose_period.nanoseconds()) {
+    last_team_history_ns_ = pose.stamp_ns;
+    team_history_.Add(PoseOf(pose));
+  }
   // Before the filter has initialised there is no frame to map in, and it
   // would refuse a switch.
   if ((pose.status & topics::kPoseStatusNotInitialised) != 0) return;
@@ -644,9 +652,32 @@ void Mapd::StartTeam(const mapping::GraphLogContents* resumed) {
                                          archive_.get(), resumed);
 }
 
+void Mapd::RetryWaitingDetections(bool final) {
+  const std::optional<Time> newest = history_.newest();
+  std::vector<mapping::GraphFactorRecord> waiting;
+  waiting.swap(waiting_detections_);
+  for (const mapping::GraphFactorRecord& d : waiting) {
+    if (!final && (!newest || *newest < Time::FromNanoseconds(d.stamp_ns))) {
+      waiting_detections_.push_back(d);
+    } else {
+      AddDetectedPose(d);
+    }
+  }
+  if (final && !waiting_detections_.empty()) {
+    // Still newer than every estimate at the end: unlinked.
+    stats_.detected_poses_unplaced += waiting_detections_.size();
+    waiting_detections_.clear();
+  }
+}
+
 void Mapd::TakeTeamConstraints() {
   for (const log::rover_msgs::GraphFactor& msg : team_->Take(newest_stamp_ns_)) {
     LogAndSubmit(msg);
+    const mapping::GraphFactorRecord f = mapping::FromMsg(msg);  // checked on arrival
+    if (f.kind == mapping::FactorKind::kRobotDetection && f.b &&
+        f.b->robot == options_.robot_id) {
+      AddDetectedPose(f);
+    }
   }
 }
 
@@ -800,7 +831,22 @@ void Mapd::HandleTagObservation(const TagSighting& sighting, mapping::TagObserva
     ApplyTagDecisions(tag_resolver_.Add(placements));
     return;
   }
-  if (o.accepted && o.marker != nullptr) ++stats_.robot_tags_seen;  // a d factor needs its graph
+  const bool robot =
+      o.marker != nullptr && o.marker->carrier == mapping::TagMarker::Carrier::kRobot;
+  if (robot && !o.accepted && o.uncertainty.ambiguous && o.inflated.accepted) {
+    // A team mate's marker has no other sightings to decide its planar
+    // ambiguity by (it moves): it is kept with its rotation left open, which
+    // still fixes where the other rover is.
+    o.uncertainty = o.inflated;
+    o.accepted = true;
+    o.refusal.clear();
+  }
+  if (o.accepted && o.marker != nullptr) {
+    ++stats_.robot_tags_seen;
+    // A detection joins the graph only in a team: it links this rover's map
+    // to the other rover's, which only the team's graph holds.
+    if (team_ && o.marker->robot != options_.robot_id) AddRobotDetection(sighting, o);
+  }
   if (o.not_configured && unknown_tag_ids_.insert(o.detection.id).second) {
     std::fprintf(stderr, "mapd: AprilTag id %d is not in the marker list: ignored\n",
                  o.detection.id);
@@ -850,14 +896,11 @@ bool Mapd::FrameInGraph(uint32_t frame_id) const {
          (frame_id > 0 && switched_frames_.count(frame_id - 1) > 0);
 }
 
-void Mapd::AddTagFactor(const TagSighting& s, const mapping::TagObservation& o) {
-  if (!slam_) return;
-  if (!FrameInGraph(s.frame_id)) {
-    ++stats_.tag_sightings_unplaced;
-    return;
-  }
-  // One pose node per image, keyed by its capture time in ms: unique, and
-  // the same after a restart.
+std::optional<int64_t> Mapd::EnsurePoseNode(const TagSighting& s) {
+  if (!FrameInGraph(s.frame_id)) return std::nullopt;
+  // One pose node per instant, keyed by its time in ms: unique, the same
+  // after a restart, and the same key on every rover for one instant (a
+  // robot detection names both rovers' poses by it).
   const int64_t pose = s.stamp_ns / 1'000'000;
   if (tag_pose_nodes_.insert(pose).second) {
     // The filter's covariance right after a frame switch is nearly zero; a
@@ -869,14 +912,68 @@ void Mapd::AddTagFactor(const TagSighting& s, const mapping::TagObservation& o) 
         mapping::FilterPoseFactor(options_.robot_id, s.frame_id, pose, s.T_local_body, covariance);
     v.stamp_ns = s.stamp_ns;
     AddFactor(std::move(v));
-    ++stats_.tag_sightings;
   }
+  return pose;
+}
+
+void Mapd::AddTagFactor(const TagSighting& s, const mapping::TagObservation& o) {
+  if (!slam_) return;
+  const bool new_node = tag_pose_nodes_.count(s.stamp_ns / 1'000'000) == 0;
+  const std::optional<int64_t> pose = EnsurePoseNode(s);
+  if (!pose) {
+    ++stats_.tag_sightings_unplaced;
+    return;
+  }
+  if (new_node) ++stats_.tag_sightings;
   mapping::GraphFactorRecord factor = mapping::LandmarkObservationFactor(
-      options_.robot_id, pose, o.marker->landmark, mapper_->T_body_cam(), o.pose->best.T_camera_tag,
-      o.uncertainty.covariance, o.marker->T_carrier_tag);
+      options_.robot_id, *pose, o.marker->landmark, mapper_->T_body_cam(),
+      o.pose->best.T_camera_tag, o.uncertainty.covariance, o.marker->T_carrier_tag);
   factor.stamp_ns = s.stamp_ns;
   AddFactor(std::move(factor));
   ++stats_.tag_factors;
+}
+
+void Mapd::AddRobotDetection(const TagSighting& s, const mapping::TagObservation& o) {
+  const std::optional<int64_t> pose = EnsurePoseNode(s);
+  if (!pose) {
+    ++stats_.robot_detections_unplaced;
+    return;
+  }
+  // The other rover's pose at the same instant gets the same key; that rover
+  // adds its filter pose there when this factor reaches it.
+  mapping::GraphFactorRecord d = mapping::RobotDetectionFactor(
+      options_.robot_id, *pose, o.marker->robot, *pose,
+      {mapper_->T_body_cam(), o.pose->best.T_camera_tag, o.uncertainty.covariance,
+       o.marker->T_carrier_tag});
+  d.stamp_ns = s.stamp_ns;
+  AddFactor(std::move(d));
+  ++stats_.robot_detections;
+}
+
+void Mapd::AddDetectedPose(const mapping::GraphFactorRecord& d) {
+  // The estimate at the detection's instant: from the recent estimates, or
+  // the decimated long history when the link was slow.
+  const Time stamp = Time::FromNanoseconds(d.stamp_ns);
+  if (!history_.newest() || *history_.newest() < stamp) {
+    // This rover's clock is behind the other's (or its estimates are late):
+    // wait for the estimates of then, within bounds.
+    if (waiting_detections_.size() < kMaxWaitingDetections) {
+      waiting_detections_.push_back(d);
+      return;
+    }
+  }
+  std::optional<StampedPose> at = history_.At(stamp);
+  if (!at) at = team_history_.At(stamp);
+  if (!at || !FrameInGraph(at->frame_id) || d.b->index != d.stamp_ns / 1'000'000) {
+    ++stats_.detected_poses_unplaced;
+    std::fprintf(stderr,
+                 "mapd: robot %d saw this rover at %.3f s, but %s: the detection stays unlinked\n",
+                 d.a.robot, stamp.ToSeconds(),
+                 !at ? "no estimate of then is kept" : "that estimate's frame is not in the graph");
+    return;
+  }
+  EnsurePoseNode({d.stamp_ns, at->frame_id, at->T_local_body, at->covariance});
+  ++stats_.detected_poses;
 }
 
 void Mapd::TakeSlamSnapshot() {
@@ -965,7 +1062,10 @@ void Mapd::Shutdown() {
     tags_->Stop();
     ApplyTagDecisions(tag_resolver_.Expire(newest_tag_stamp_ns_, true));
   }
-  if (team_) TakeTeamConstraints();
+  if (team_) {
+    TakeTeamConstraints();
+    RetryWaitingDetections(true);
+  }
   if (slam_) {
     HandLatestPose();  // the run's final global pose is the last estimate's
     slam_->Flush();
@@ -1029,6 +1129,9 @@ void Mapd::Shutdown() {
     graph["team_link_bytes_sent"] = std::to_string(t.worker.link.sent_bytes);
     graph["team_link_bytes_received"] = std::to_string(t.worker.link.received_bytes);
     graph["team_link_bytes_per_s"] = std::to_string(t.link_bytes_per_s);
+    graph["team_robot_detections"] = std::to_string(stats_.robot_detections);
+    graph["team_detected_poses"] = std::to_string(stats_.detected_poses);
+    graph["team_detected_poses_unplaced"] = std::to_string(stats_.detected_poses_unplaced);
     graph["team_duplicate_fragments"] = std::to_string(t.worker.sync.duplicate_fragments);
     graph["team_refused_datagrams"] = std::to_string(t.worker.sync.refused_datagrams);
   }
@@ -1130,14 +1233,15 @@ std::string Mapd::Summary() const {
   }
   if (tags_) {
     const TagWorkerStats t = tags_->Stats();
-    char text[520];
+    char text[640];
     std::snprintf(text, sizeof(text),
                   "  tags: %llu images searched (%llu dropped, %llu failed); %llu decoded: %llu "
                   "accepted, %llu not in the marker list, %llu refused by the detector, %llu by "
                   "the error model (of these ambiguous ones, %llu decided by the tag's other "
                   "sightings, %llu kept with their rotation left open, %llu refused); %llu images "
                   "-> %llu o factors (%llu tags before their "
-                  "frame was in the graph), %llu robot markers\n",
+                  "frame was in the graph), %llu robot markers (%llu d factors; this rover seen by "
+                  "others %llu times, %llu of them unlinked)\n",
                   static_cast<unsigned long long>(t.observer.images),
                   static_cast<unsigned long long>(t.dropped + t.not_ready),
                   static_cast<unsigned long long>(t.failed),
@@ -1152,7 +1256,10 @@ std::string Mapd::Summary() const {
                   static_cast<unsigned long long>(stats_.tag_sightings),
                   static_cast<unsigned long long>(stats_.tag_factors),
                   static_cast<unsigned long long>(stats_.tag_sightings_unplaced),
-                  static_cast<unsigned long long>(stats_.robot_tags_seen));
+                  static_cast<unsigned long long>(stats_.robot_tags_seen),
+                  static_cast<unsigned long long>(stats_.robot_detections),
+                  static_cast<unsigned long long>(stats_.detected_poses + stats_.detected_poses_unplaced),
+                  static_cast<unsigned long long>(stats_.detected_poses_unplaced));
     out += text;
   }
   if (team_) out += team_->Summary();

@@ -115,6 +115,10 @@ struct MapdOptions {
   /// join this rover's graph; the graph's robot id is robot_id.
   /// nullopt: alone.
   std::optional<TeamWorkerOptions> team{};
+  /// In a team, estimates kept at this period for the other rovers'
+  /// detections of this one, which may arrive minutes late (10 min).
+  Duration team_pose_period = Duration::Milliseconds(100);
+  std::size_t team_pose_history = 6000;
 
   /// Throws std::invalid_argument naming the key.
   void Validate() const;
@@ -167,7 +171,11 @@ struct MapdStats {
   uint64_t tags_resolved = 0;           ///< ambiguous, decided by the tag's other sightings
   uint64_t tags_inflated = 0;           ///< ambiguous, undecided: kept with the rotation left open
   uint64_t tags_unresolved = 0;         ///< ambiguous, and refused in the end (fit neither)
-  uint64_t robot_tags_seen = 0;         ///< accepted robot markers (logged, no factor)
+  uint64_t robot_tags_seen = 0;         ///< accepted robot markers (logged)
+  uint64_t robot_detections = 0;        ///< d factors added (in a team)
+  uint64_t robot_detections_unplaced = 0;  ///< this rover's frame was not in the graph
+  uint64_t detected_poses = 0;  ///< other rovers' detections of this one linked (v added)
+  uint64_t detected_poses_unplaced = 0;  ///< no estimate of then kept, or its frame not in the graph
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
@@ -286,6 +294,18 @@ class Mapd {
   void LogTag(const TagSighting& sighting, const mapping::TagObservation& observation);
   /// The sighting's pose (v, once per image) and the tag's o factor.
   void AddTagFactor(const TagSighting& sighting, const mapping::TagObservation& observation);
+  /// This rover's pose node at the sighting's instant (its v factor, once);
+  /// nullopt if the sighting's frame is not in the graph.
+  std::optional<int64_t> EnsurePoseNode(const TagSighting& sighting);
+  /// A team mate's marker seen: this rover's pose node and the d factor to
+  /// the other rover's pose at the same instant.
+  void AddRobotDetection(const TagSighting& sighting, const mapping::TagObservation& observation);
+  /// Another rover saw this one (`detection` names this rover's pose): adds
+  /// this rover's estimate of then as that pose's v factor.
+  void AddDetectedPose(const mapping::GraphFactorRecord& detection);
+  /// Detections of this rover newer than its newest estimate wait for the
+  /// estimates of their instant; `final`: the last try (end of the run).
+  void RetryWaitingDetections(bool final);
   /// True if local frame `frame_id`'s origin is in the graph (the prior's
   /// frame, or one a frame switch led to).
   bool FrameInGraph(uint32_t frame_id) const;
@@ -310,6 +330,12 @@ class Mapd {
   std::unique_ptr<runtime::topics::StereoFrameMsg> pending_frame_;
   bool has_pending_ = false;
   PoseHistory history_;
+  PoseHistory team_history_;  ///< decimated, for late detections by team mates
+  int64_t last_team_history_ns_ = 0;
+  /// Other rovers' detections of this one from its future (the clocks of a
+  /// lockstep simulation differ, a real one's estimates lag).
+  std::vector<mapping::GraphFactorRecord> waiting_detections_;
+  static constexpr std::size_t kMaxWaitingDetections = 4096;
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<mapping::Submap> mapping_submap_;
   std::unique_ptr<SubmapArchive> archive_;

@@ -126,6 +126,19 @@ GraphFactorRecord LandmarkObservationFactor(int robot, int64_t pose, int64_t lan
   return r;
 }
 
+GraphFactorRecord RobotDetectionFactor(int observer, int64_t observer_pose, int target,
+                                       int64_t target_pose, const RobotDetection& detection) {
+  const auto [T_body0_body1, covariance] = ComposeDetection(detection);
+  GraphFactorRecord r;
+  r.kind = FactorKind::kRobotDetection;
+  r.a = GraphKey::Pose(observer, observer_pose);
+  r.b = GraphKey::Pose(target, target_pose);
+  r.T_a_b = T_body0_body1;
+  r.covariance = covariance;
+  r.robust = true;
+  return r;
+}
+
 void AddToGraph(const GraphFactorRecord& r, RoverGraph* graph) {
   using Type = GraphKey::Type;
   const bool binary = r.b.has_value();

@@ -17,6 +17,7 @@
 #include "core/log/msgs/rover_msgs.h"
 #include "mapping/graph/graph_key.h"
 #include "mapping/graph/pose_graph.h"
+#include "mapping/graph/rover_graph.h"
 
 namespace rover::mapping {
 
@@ -83,6 +84,14 @@ GraphFactorRecord LandmarkObservationFactor(int robot, int64_t pose, int64_t lan
                                             const Eigen::Isometry3d& T_cam_tag,
                                             const Matrix6d& covariance_cam_tag,
                                             const Eigen::Isometry3d& T_landmark_tag);
+
+/// d: robot `observer`'s pose x^observer_pose sees a marker of robot
+/// `target`, whose pose at the same instant is x^target_target_pose:
+/// T_body0_body1 = T_body_cam * T_cam_marker * T_body_marker^-1, with the
+/// marker pose's covariance propagated to first order (ComposeDetection).
+/// Robust.
+GraphFactorRecord RobotDetectionFactor(int observer, int64_t observer_pose, int target,
+                                       int64_t target_pose, const RobotDetection& detection);
 
 /// Adds `record` to `graph` through the matching RoverGraph call. Throws
 /// GraphError (naming the factor) for NaN, a covariance that is not

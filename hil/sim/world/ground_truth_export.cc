@@ -246,8 +246,12 @@ std::string TagMarkerFile(const World& world) {
       << "): landmark posts and other rovers.\n"
       << "families: [tag36h11]\nmarkers:\n";
   int64_t landmark = 0;
-  int robot = 1;
+  // Robot ids are the team's rover numbers (MakeTeamRovers, rover-team): the
+  // scenario's own rover "rover_a" is 0, the other rovers 1, 2, ... in world
+  // order.
+  int next_other_robot = 1;
   for (const TagCarrier& carrier : world.carriers) {
+    const int robot = carrier.name == "rover_a" ? 0 : next_other_robot;
     for (const TagMarker& tag : carrier.tags) {
       out << "  - {id: " << tag.id << ", size_m: " << Num(tag.size_m) << ", ";
       if (carrier.is_static) {
@@ -262,8 +266,8 @@ std::string TagMarkerFile(const World& world) {
     }
     if (carrier.is_static) {
       ++landmark;
-    } else {
-      ++robot;
+    } else if (robot > 0) {
+      ++next_other_robot;
     }
   }
   return out.str();
