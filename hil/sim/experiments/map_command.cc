@@ -283,6 +283,25 @@ void ReportFrameSwitchConsistency(const mapping::GraphLogContents& g,
 
 // The logged graph re-solved, with `extra` factors, optionally without the
 // tag sightings (v, o) and with the frame switches' sigmas scaled.
+// This rover's part of a logged graph: the factors whose keys are all its
+// own (or landmarks). A team rover's log also holds what the others sent,
+// which the truth of this rover cannot score.
+mapping::GraphLogContents OwnPart(const mapping::GraphLogContents& g, int robot) {
+  const auto own = [robot](const mapping::GraphKey& k) {
+    return k.type == mapping::GraphKey::Type::kLandmark || k.robot == robot;
+  };
+  mapping::GraphLogContents out = g;
+  out.factors.clear();
+  out.messages.clear();
+  for (std::size_t k = 0; k < g.factors.size(); ++k) {
+    const mapping::GraphFactorRecord& f = g.factors[k];
+    if (!own(f.a) || (f.b && !own(*f.b))) continue;
+    out.factors.push_back(f);
+    out.messages.push_back(g.messages[k]);
+  }
+  return out;
+}
+
 std::unique_ptr<mapping::RoverGraph> Resolved(const mapping::GraphLogContents& g,
                                               const std::vector<mapping::GraphFactorRecord>& extra,
                                               double switch_sigma_scale, bool without_tags) {
@@ -385,6 +404,27 @@ void ScoreTagSightings(const mapping::GraphLogContents& g, const Eigen::Isometry
          << Num(r->slam_without_tags_error_pct, 4) << " %\n";
 }
 
+// In a team: the logged graph re-solved whole (the team's factors in it)
+// and with this rover's own factors alone, scored as the logged final
+// position: what the team did for this rover on the same run.
+void ScoreTeam(const mapping::GraphLogContents& all, const mapping::GraphLogContents& own,
+               const Eigen::Isometry3d& T_world_graph, const Eigen::Vector3d& p_true,
+               double distance_m, MapResult* r, std::ostream& report) {
+  r->team_factors = all.factors.size() - own.factors.size();
+  if (r->team_factors == 0 || distance_m <= 0.0) return;
+  const Eigen::Vector3d whole =
+      T_world_graph *
+      mapping::MovedFinalGlobalPose(all, *Resolved(all, {}, 1.0, false)).translation();
+  const Eigen::Vector3d alone =
+      T_world_graph *
+      mapping::MovedFinalGlobalPose(own, *Resolved(own, {}, 1.0, false)).translation();
+  r->slam_team_resolved_error_pct = 100.0 * (whole - p_true).norm() / distance_m;
+  r->slam_alone_error_pct = 100.0 * (alone - p_true).norm() / distance_m;
+  report << "  team: " << r->team_factors << " factors name other rovers; the logged graph "
+         << "re-solved: final error " << Num(r->slam_team_resolved_error_pct, 4)
+         << " %, this rover's factors alone " << Num(r->slam_alone_error_pct, 4) << " %\n";
+}
+
 // Each optimised origin's error against its true origin, both taken relative
 // to the graph's first origin: where along the mission the graph's error
 // grows (every 5th origin and the last).
@@ -445,8 +485,13 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
                          std::map<uint32_t, Eigen::Isometry3d>* origins, MapResult* r,
                          std::ostream& report) {
   for (const std::string& path : mapd_logs) {
-    mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
-    for (const std::string& p : g.problems) report << "    graph: " << p << "\n";
+    const mapping::GraphLogContents all = mapping::ReadGraphLogs({path});
+    for (const std::string& p : all.problems) report << "    graph: " << p << "\n";
+    // The log's own robot: that of its origins (mapd logs only its own).
+    const int self = all.last_origins && !all.last_origins->origins.empty()
+                         ? all.last_origins->origins.front().robot
+                         : static_cast<int>(mission.rover);
+    mapping::GraphLogContents g = OwnPart(all, self);
     if (options.rematch) {
       LoopReplayOptions replay;
       replay.reapply_switch_noise = options.rematch_reapply_switch_noise;
@@ -506,6 +551,7 @@ void PlaceAtGraphOrigins(const std::vector<std::string>& mapd_logs,
               .p_world_body;
         },
         r, report);
+    ScoreTeam(all, g, *T_world_graph, p_true, distance_m, r, report);
     if ((options.false_match_fraction > 0.0 || options.switch_sigma_scale != 1.0) &&
         distance_m > 0.0) {
       ScoreFalseMatches(g, *T_world_graph, p_true, distance_m, options, r, report);
@@ -667,7 +713,9 @@ std::string MapResultFields(const MapResult& r) {
          " tag_factors=" + std::to_string(r.tag_factors) +
          " tag_nees_in_bound_pct=" + Num(r.tags.nees_in_bound_pct, 1) +
          " tag_flips_claimed=" + std::to_string(r.tags.wrong_solutions_claimed) +
-         " slam_without_tags_err_pct=" + Num(r.slam_without_tags_error_pct, 4);
+         " slam_without_tags_err_pct=" + Num(r.slam_without_tags_error_pct, 4) +
+         " team_factors=" + std::to_string(r.team_factors) +
+         " slam_alone_err_pct=" + Num(r.slam_alone_error_pct, 4);
 }
 
 int RunMap(const MapCommandOptions& options, std::ostream& out, std::ostream& err) {

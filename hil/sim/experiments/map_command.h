@@ -90,6 +90,12 @@ struct MapResult {
   /// the tags did on the same run.
   double slam_resolved_error_pct = std::numeric_limits<double>::quiet_NaN();
   double slam_without_tags_error_pct = std::numeric_limits<double>::quiet_NaN();
+  /// In a team: factors in this rover's log that name other rovers, and the
+  /// logged graph re-solved whole and with this rover's own factors alone
+  /// (final error, % of distance): what the team did for this rover.
+  uint64_t team_factors = 0;
+  double slam_team_resolved_error_pct = std::numeric_limits<double>::quiet_NaN();
+  double slam_alone_error_pct = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Evaluates; throws std::runtime_error naming the file or the problem.

@@ -94,7 +94,8 @@ void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
                  "submaps=0 submap_bytes_per_s=nan raw_stereo_bytes_per_s=nan loop_closures=0 "
                  "loop_closure_precision=nan matcher_ms_p50=nan graph_update_ms_p99=nan "
                  "frame_switch_nees=nan tag_detections=0 tag_factors=0 "
-                 "tag_nees_in_bound_pct=nan tag_flips_claimed=0 slam_without_tags_err_pct=nan\n";
+                 "tag_nees_in_bound_pct=nan tag_flips_claimed=0 slam_without_tags_err_pct=nan "
+                 "team_factors=0 slam_alone_err_pct=nan\n";
   }
 }
 
