@@ -674,8 +674,7 @@ void Mapd::TakeTeamConstraints() {
   for (const log::rover_msgs::GraphFactor& msg : team_->Take(newest_stamp_ns_)) {
     LogAndSubmit(msg);
     const mapping::GraphFactorRecord f = mapping::FromMsg(msg);  // checked on arrival
-    if (f.kind == mapping::FactorKind::kRobotDetection && f.b &&
-        f.b->robot == options_.robot_id) {
+    if (f.kind == mapping::FactorKind::kRobotDetection && f.b && f.b->robot == options_.robot_id) {
       AddDetectedPose(f);
     }
   }
@@ -941,10 +940,10 @@ void Mapd::AddRobotDetection(const TagSighting& s, const mapping::TagObservation
   }
   // The other rover's pose at the same instant gets the same key; that rover
   // adds its filter pose there when this factor reaches it.
-  mapping::GraphFactorRecord d = mapping::RobotDetectionFactor(
-      options_.robot_id, *pose, o.marker->robot, *pose,
-      {mapper_->T_body_cam(), o.pose->best.T_camera_tag, o.uncertainty.covariance,
-       o.marker->T_carrier_tag});
+  mapping::GraphFactorRecord d =
+      mapping::RobotDetectionFactor(options_.robot_id, *pose, o.marker->robot, *pose,
+                                    {mapper_->T_body_cam(), o.pose->best.T_camera_tag,
+                                     o.uncertainty.covariance, o.marker->T_carrier_tag});
   d.stamp_ns = s.stamp_ns;
   AddFactor(std::move(d));
   ++stats_.robot_detections;
@@ -1234,32 +1233,33 @@ std::string Mapd::Summary() const {
   if (tags_) {
     const TagWorkerStats t = tags_->Stats();
     char text[640];
-    std::snprintf(text, sizeof(text),
-                  "  tags: %llu images searched (%llu dropped, %llu failed); %llu decoded: %llu "
-                  "accepted, %llu not in the marker list, %llu refused by the detector, %llu by "
-                  "the error model (of these ambiguous ones, %llu decided by the tag's other "
-                  "sightings, %llu kept with their rotation left open, %llu refused); %llu images "
-                  "-> %llu o factors (%llu tags before their "
-                  "frame was in the graph), %llu robot markers (%llu d factors; this rover seen by "
-                  "others %llu times, %llu of them unlinked)\n",
-                  static_cast<unsigned long long>(t.observer.images),
-                  static_cast<unsigned long long>(t.dropped + t.not_ready),
-                  static_cast<unsigned long long>(t.failed),
-                  static_cast<unsigned long long>(t.observer.decoded),
-                  static_cast<unsigned long long>(t.observer.accepted),
-                  static_cast<unsigned long long>(t.observer.not_configured),
-                  static_cast<unsigned long long>(t.observer.refused_by_detector),
-                  static_cast<unsigned long long>(t.observer.refused_by_model),
-                  static_cast<unsigned long long>(stats_.tags_resolved),
-                  static_cast<unsigned long long>(stats_.tags_inflated),
-                  static_cast<unsigned long long>(stats_.tags_unresolved),
-                  static_cast<unsigned long long>(stats_.tag_sightings),
-                  static_cast<unsigned long long>(stats_.tag_factors),
-                  static_cast<unsigned long long>(stats_.tag_sightings_unplaced),
-                  static_cast<unsigned long long>(stats_.robot_tags_seen),
-                  static_cast<unsigned long long>(stats_.robot_detections),
-                  static_cast<unsigned long long>(stats_.detected_poses + stats_.detected_poses_unplaced),
-                  static_cast<unsigned long long>(stats_.detected_poses_unplaced));
+    std::snprintf(
+        text, sizeof(text),
+        "  tags: %llu images searched (%llu dropped, %llu failed); %llu decoded: %llu "
+        "accepted, %llu not in the marker list, %llu refused by the detector, %llu by "
+        "the error model (of these ambiguous ones, %llu decided by the tag's other "
+        "sightings, %llu kept with their rotation left open, %llu refused); %llu images "
+        "-> %llu o factors (%llu tags before their "
+        "frame was in the graph), %llu robot markers (%llu d factors; this rover seen by "
+        "others %llu times, %llu of them unlinked)\n",
+        static_cast<unsigned long long>(t.observer.images),
+        static_cast<unsigned long long>(t.dropped + t.not_ready),
+        static_cast<unsigned long long>(t.failed),
+        static_cast<unsigned long long>(t.observer.decoded),
+        static_cast<unsigned long long>(t.observer.accepted),
+        static_cast<unsigned long long>(t.observer.not_configured),
+        static_cast<unsigned long long>(t.observer.refused_by_detector),
+        static_cast<unsigned long long>(t.observer.refused_by_model),
+        static_cast<unsigned long long>(stats_.tags_resolved),
+        static_cast<unsigned long long>(stats_.tags_inflated),
+        static_cast<unsigned long long>(stats_.tags_unresolved),
+        static_cast<unsigned long long>(stats_.tag_sightings),
+        static_cast<unsigned long long>(stats_.tag_factors),
+        static_cast<unsigned long long>(stats_.tag_sightings_unplaced),
+        static_cast<unsigned long long>(stats_.robot_tags_seen),
+        static_cast<unsigned long long>(stats_.robot_detections),
+        static_cast<unsigned long long>(stats_.detected_poses + stats_.detected_poses_unplaced),
+        static_cast<unsigned long long>(stats_.detected_poses_unplaced));
     out += text;
   }
   if (team_) out += team_->Summary();

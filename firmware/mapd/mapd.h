@@ -175,7 +175,8 @@ struct MapdStats {
   uint64_t robot_detections = 0;        ///< d factors added (in a team)
   uint64_t robot_detections_unplaced = 0;  ///< this rover's frame was not in the graph
   uint64_t detected_poses = 0;  ///< other rovers' detections of this one linked (v added)
-  uint64_t detected_poses_unplaced = 0;  ///< no estimate of then kept, or its frame not in the graph
+  uint64_t detected_poses_unplaced =
+      0;  ///< no estimate of then kept, or its frame not in the graph
   double mapping_ms_total = 0.0;
   /// First and last stereo pair seen (any), for the raw stereo byte rate.
   std::optional<uint64_t> first_sequence;
