@@ -6,51 +6,16 @@
 #include "core/link/wire.h"
 #include "core/log/msgs/message_traits.h"
 #include "core/log/msgs/rover_msgs.h"
+#include "mapping/team/message_head.h"
 
 namespace rover::mapping {
 namespace {
 
-enum class Kind : uint8_t { kConstraint = 1, kMatchClaim = 2, kHeartbeat = 3 };
-
-const char* Name(Kind kind) {
-  switch (kind) {
-    case Kind::kConstraint:
-      return "team constraint";
-    case Kind::kMatchClaim:
-      return "team match claim";
-    case Kind::kHeartbeat:
-      return "team heartbeat";
-  }
-  return "team message";
-}
-
-void WriteHead(link::wire::Writer* w, Kind kind) {
-  w->U8(kTeamMessageVersion);
-  w->U8(static_cast<uint8_t>(kind));
-}
-
-// Reads and checks the version and kind; throws naming what was found.
-void ReadHead(link::wire::Reader* r, Kind kind) {
-  const uint8_t version = r->U8();
-  const uint8_t found = r->U8();
-  if (r->failed()) throw TeamMessageError(std::string(Name(kind)) + ": truncated header");
-  if (version != kTeamMessageVersion) {
-    throw TeamMessageError(std::string(Name(kind)) + ": version " + std::to_string(version) +
-                           ", expected " + std::to_string(kTeamMessageVersion));
-  }
-  if (found != static_cast<uint8_t>(kind)) {
-    throw TeamMessageError(std::string(Name(kind)) + ": kind " + std::to_string(found) +
-                           ", expected " + std::to_string(static_cast<int>(kind)));
-  }
-}
-
-void CheckEnd(const link::wire::Reader& r, Kind kind) {
-  if (r.failed()) throw TeamMessageError(std::string(Name(kind)) + ": truncated");
-  if (r.remaining() != 0) {
-    throw TeamMessageError(std::string(Name(kind)) + ": " + std::to_string(r.remaining()) +
-                           " bytes after the end");
-  }
-}
+using team_internal::CheckEnd;
+using team_internal::Kind;
+using team_internal::Name;
+using team_internal::ReadHead;
+using team_internal::WriteHead;
 
 void WriteKey(link::wire::Writer* w, const GraphKey& key) {
   w->U8(static_cast<uint8_t>(key.type));
