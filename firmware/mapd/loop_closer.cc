@@ -2,10 +2,13 @@
 
 #include <malloc.h>
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
+#include <tuple>
 
 #include "firmware/runtime/rt/thread_priority.h"
+#include "mapping/graph/pose_uncertainty.h"
 
 namespace rover::mapd {
 namespace {
@@ -76,19 +79,49 @@ void LoopCloser::AddSubmap(std::shared_ptr<const mapping::Submap> submap) {
   if (!submap) return;
   {
     const std::lock_guard lock(mutex_);
-    waiting_.push_back(std::move(submap));
+    const mapping::SubmapId id{robot_, submap->frame_id()};
+    waiting_.push_back(Waiting{id, std::move(submap), nullptr, nullptr});
     ++stats_.submaps;
   }
   wake_pairing_.notify_all();
 }
 
-void LoopCloser::UpdateOrigins(const std::map<int64_t, OptimisedOrigin>& origins) {
+void LoopCloser::AddTeamSubmap(const mapping::SubmapId& id,
+                               std::shared_ptr<const octomap::OcTree> octree,
+                               std::shared_ptr<const mapping::PointCloud> cloud) {
+  if (!octree || !cloud || id.robot == robot_) return;
   {
     const std::lock_guard lock(mutex_);
-    origins_ = origins;
+    waiting_.push_back(Waiting{id, nullptr, std::move(octree), std::move(cloud)});
+    ++stats_.submaps;
+    ++stats_.team_submaps;
+  }
+  wake_pairing_.notify_all();
+}
+
+void LoopCloser::UpdateOrigins(const std::map<int64_t, OptimisedOrigin>& origins,
+                               const std::map<mapping::SubmapId, OptimisedOrigin>& team_origins) {
+  {
+    const std::lock_guard lock(mutex_);
+    origins_ = team_origins;
+    for (const auto& [frame, origin] : origins) origins_[mapping::SubmapId{robot_, frame}] = origin;
     origins_changed_ = true;
   }
   wake_pairing_.notify_all();
+}
+
+void LoopCloser::AddClaim(const mapping::SubmapId& a, const mapping::SubmapId& b, int claimant) {
+  if (claimant == robot_) return;
+  const std::lock_guard lock(mutex_);
+  const auto [it, added] = claimed_.emplace(KeyOf(a, b), claimant);
+  if (!added) it->second = std::min(it->second, claimant);
+}
+
+std::vector<std::pair<mapping::SubmapId, mapping::SubmapId>> LoopCloser::TakeClaims() {
+  const std::lock_guard lock(mutex_);
+  std::vector<PairKey> out;
+  out.swap(claims_out_);
+  return out;
 }
 
 std::vector<LoopMatch> LoopCloser::TakeMatches() {
@@ -152,20 +185,21 @@ void LoopCloser::RunPairing() {
 
 void LoopCloser::PrepareWaiting(std::unique_lock<std::mutex>* lock) {
   while (!waiting_.empty() && !stop_) {
-    std::shared_ptr<const mapping::Submap> submap = std::move(waiting_.front());
+    Waiting w = std::move(waiting_.front());
     waiting_.pop_front();
     preparing_ = true;
     lock->unlock();
     std::shared_ptr<const mapping::SubmapMatchData> data;
     std::string problem;
     try {
-      data = mapping::SubmapMatchData::Build(submap->cloud(), submap->octree(), options_.data);
+      data = w.submap ? mapping::SubmapMatchData::Build(w.submap->cloud(), w.submap->octree(),
+                                                        options_.data)
+                      : mapping::SubmapMatchData::Build(*w.cloud, *w.octree, options_.data);
     } catch (const std::exception& e) {
-      problem = "loop closures: submap " + std::to_string(submap->frame_id()) +
-                " has no matching data: " + e.what();
+      problem = "loop closures: submap " + w.id.ToString() + " has no matching data: " + e.what();
     }
-    const int64_t frame = submap->frame_id();
-    submap.reset();    // the octree and cloud are no longer needed here
+    const mapping::SubmapId id = w.id;
+    w = Waiting{};     // the octree and cloud are no longer needed here
     ::malloc_trim(0);  // nor the build's transients: see RunMatching
     lock->lock();
     preparing_ = false;
@@ -176,20 +210,21 @@ void LoopCloser::PrepareWaiting(std::unique_lock<std::mutex>* lock) {
     }
     stats_.data_ms.push_back(data->build_ms());
     if (data->suitable()) ++stats_.submaps_suitable;
-    prepared_[frame] = Prepared{};
+    prepared_[id] = Prepared{};
     try {
-      store_.Put(frame, std::move(data));
+      store_.Put(StoreKey(id), std::move(data));
     } catch (const std::exception& e) {  // stored all the same, in memory
       problems_.push_back(std::string("loop closures: ") + e.what());
     }
   }
 }
 
-std::shared_ptr<const mapping::SubmapMatchData> LoopCloser::StoredData(int64_t frame) {
+std::shared_ptr<const mapping::SubmapMatchData> LoopCloser::StoredData(
+    const mapping::SubmapId& id) {
   try {
-    return store_.Get(frame);
+    return store_.Get(StoreKey(id));
   } catch (const std::exception& e) {
-    problems_.push_back("loop closures: submap " + std::to_string(frame) +
+    problems_.push_back("loop closures: submap " + id.ToString() +
                         " leaves the pairing: " + e.what());
     return nullptr;
   }
@@ -198,29 +233,27 @@ std::shared_ptr<const mapping::SubmapMatchData> LoopCloser::StoredData(int64_t f
 void LoopCloser::SyncPairing() {
   const bool changed = origins_changed_;
   origins_changed_ = false;
-  for (auto& [frame, p] : prepared_) {
-    const auto origin = origins_.find(frame);
+  for (auto& [id, p] : prepared_) {
+    const auto origin = origins_.find(id);
     if (origin == origins_.end() || !FiniteCovariance(origin->second.covariance)) continue;
-    const mapping::SubmapId id{robot_, frame};
     if (!p.paired) {
       p.paired = true;
-      const std::shared_ptr<const mapping::SubmapMatchData> data = StoredData(frame);
+      const std::shared_ptr<const mapping::SubmapMatchData> data = StoredData(id);
       if (!data) continue;
       try {
         pairing_.AddSubmap(id, *data, origin->second.T_world_origin, origin->second.covariance);
         p.in_pairing = true;
       } catch (const std::exception& e) {
-        problems_.push_back("loop closures: submap " + std::to_string(frame) +
+        problems_.push_back("loop closures: submap " + id.ToString() +
                             " left out of the pairing: " + e.what());
       }
       // The pairing keeps what it needs of an unsuitable submap.
-      if (!p.in_pairing || !data->suitable()) store_.Erase(frame);
+      if (!p.in_pairing || !data->suitable()) store_.Erase(StoreKey(id));
     } else if (changed && p.in_pairing) {
       try {
         pairing_.UpdateOrigin(id, origin->second.T_world_origin, origin->second.covariance);
       } catch (const std::exception& e) {
-        problems_.push_back("loop closures: origin " + std::to_string(frame) +
-                            " not updated: " + e.what());
+        problems_.push_back("loop closures: origin " + id.ToString() + " not updated: " + e.what());
       }
     }
   }
@@ -230,14 +263,29 @@ void LoopCloser::QueuePairs() {
   while (queue_.size() < static_cast<std::size_t>(options_.max_queued_pairs)) {
     std::optional<mapping::SubmapPair> next = pairing_.Next();
     if (!next) break;
-    // Another robot's submap is not matched here; one whose data cannot
-    // be read back is not matched at all (noted as a problem).
-    if (next->a.robot != robot_ || next->b.robot != robot_ || !store_.Contains(next->a.index) ||
-        !store_.Contains(next->b.index)) {
+    const bool own_a = next->a.robot == robot_;
+    const bool own_b = next->b.robot == robot_;
+    // Two other rovers' submaps: theirs to match. One whose data cannot be
+    // read back is not matched at all (noted as a problem).
+    if ((!own_a && !own_b) || !store_.Contains(StoreKey(next->a)) ||
+        !store_.Contains(StoreKey(next->b))) {
       continue;
     }
-    std::shared_ptr<const mapping::SubmapMatchData> a = StoredData(next->a.index);
-    std::shared_ptr<const mapping::SubmapMatchData> b = StoredData(next->b.index);
+    if (own_a != own_b) {
+      if (claimed_.count(KeyOf(next->a, next->b)) > 0) {
+        ++stats_.pairs_claimed_by_others;
+        continue;
+      }
+      claims_out_.push_back(KeyOf(next->a, next->b));
+    }
+    if (!own_a) {
+      // This rover's submap first: the factor is this rover's.
+      std::swap(next->a, next->b);
+      std::tie(next->prior.T_a_b, next->prior.covariance) =
+          mapping::InvertUncertainPose(next->prior.T_a_b, next->prior.covariance);
+    }
+    std::shared_ptr<const mapping::SubmapMatchData> a = StoredData(next->a);
+    std::shared_ptr<const mapping::SubmapMatchData> b = StoredData(next->b);
     if (!a || !b) continue;
     queue_.push_back(QueuedPair{*next, std::move(a), std::move(b)});
   }
@@ -279,6 +327,18 @@ void LoopCloser::RunMatching() {
     ::malloc_trim(0);
     lock.lock();
     matching_ = false;
+    const bool team = m.a.robot != m.b.robot;
+    if (team) {
+      // Both rovers started on this pair before either heard the other's
+      // claim: the lower id's match counts.
+      const auto claim = claimed_.find(KeyOf(m.a, m.b));
+      if (claim != claimed_.end() && claim->second < robot_ && m.accepted) {
+        m.accepted = false;
+        m.rejection = "robot " + std::to_string(claim->second) + " claimed this pair first";
+      }
+      ++stats_.team_pairs_matched;
+      if (m.accepted) ++stats_.team_matches_accepted;
+    }
     ++stats_.pairs_matched;
     if (m.accepted) ++stats_.matches_accepted;
     stats_.match_ms.push_back(m.match_ms);

@@ -17,6 +17,12 @@
 // used in memory and spills the rest to disk, so that memory stays flat on
 // a long mission. The data of a submap the pairing refused as unsuitable is
 // dropped at once.
+//
+// In a team, the other rovers' submaps (from the team link) join the pairing
+// at the graph's estimate of their origins. A pair of this rover's submap
+// and another rover's is matched here unless that rover announced it first
+// (a claim); a pair of two other rovers' submaps is theirs. Every match is
+// reported with this rover's submap as `a`, so the factor is this rover's.
 
 #include <cmath>
 #include <condition_variable>
@@ -32,6 +38,7 @@
 #include "core/config/config.h"
 #include "firmware/mapd/slam_worker.h"
 #include "mapping/loop/match_data_store.h"
+#include "mapping/loop/submap_id.h"
 #include "mapping/loop/submap_match_data.h"
 #include "mapping/loop/submap_matcher.h"
 #include "mapping/loop/submap_pairing.h"
@@ -123,8 +130,12 @@ struct LoopCloserStats {
   uint64_t submaps_failed = 0;    ///< matching data could not be computed (message in problems)
   uint64_t pairs_matched = 0;
   uint64_t matches_accepted = 0;
-  std::vector<double> data_ms;   ///< per submap
-  std::vector<double> match_ms;  ///< per matched pair
+  uint64_t team_submaps = 0;        ///< other rovers' submaps handed over
+  uint64_t team_pairs_matched = 0;  ///< of pairs_matched, with another rover's submap
+  uint64_t team_matches_accepted = 0;
+  uint64_t pairs_claimed_by_others = 0;  ///< left to the rover that announced them
+  std::vector<double> data_ms;           ///< per submap
+  std::vector<double> match_ms;          ///< per matched pair
   mapping::MatchDataStoreStats store;
 };
 
@@ -140,9 +151,21 @@ class LoopCloser {
   /// Hands over a finished submap; its matching data is computed in the
   /// pairing thread, which keeps `submap` only until then.
   void AddSubmap(std::shared_ptr<const mapping::Submap> submap);
-  /// The graph's origin estimates after an update (this robot's, by local
-  /// frame id). A submap joins the pairing once its origin is known.
-  void UpdateOrigins(const std::map<int64_t, OptimisedOrigin>& origins);
+  /// Hands over another rover's finished submap `id` (from the team link).
+  void AddTeamSubmap(const mapping::SubmapId& id, std::shared_ptr<const octomap::OcTree> octree,
+                     std::shared_ptr<const mapping::PointCloud> cloud);
+  /// The graph's origin estimates after an update: this robot's by local
+  /// frame id, and the other rovers' the graph has placed. A submap joins
+  /// the pairing once its origin is known.
+  void UpdateOrigins(const std::map<int64_t, OptimisedOrigin>& origins,
+                     const std::map<mapping::SubmapId, OptimisedOrigin>& team_origins = {});
+  /// Robot `claimant` announced that it matches `a` with `b`: not matched
+  /// here, and a match of that pair finished here is refused if the claimant
+  /// has the lower id (the tie-break when both started at once).
+  void AddClaim(const mapping::SubmapId& a, const mapping::SubmapId& b, int claimant);
+  /// Pairs of this rover's submap and another rover's that this rover
+  /// started to match since the last call, to announce to the team.
+  std::vector<std::pair<mapping::SubmapId, mapping::SubmapId>> TakeClaims();
   /// Matches finished since the last call, in the order they finished.
   std::vector<LoopMatch> TakeMatches();
   /// Messages (submaps whose data failed) since the last call.
@@ -159,6 +182,22 @@ class LoopCloser {
     bool paired = false;      ///< tried to add to the pairing
     bool in_pairing = false;  ///< added
   };
+  /// A submap waiting for its matching data: this rover's (`submap`) or
+  /// another's (`octree` and `cloud`).
+  struct Waiting {
+    mapping::SubmapId id;
+    std::shared_ptr<const mapping::Submap> submap;
+    std::shared_ptr<const octomap::OcTree> octree;
+    std::shared_ptr<const mapping::PointCloud> cloud;
+  };
+  using PairKey = std::pair<mapping::SubmapId, mapping::SubmapId>;  ///< ordered
+  static PairKey KeyOf(const mapping::SubmapId& a, const mapping::SubmapId& b) {
+    return a < b ? PairKey{a, b} : PairKey{b, a};
+  }
+  /// The match data store's key of a submap (robot in the high bits).
+  static int64_t StoreKey(const mapping::SubmapId& id) {
+    return (static_cast<int64_t>(id.robot) << 40) | id.index;
+  }
   void RunPairing();
   void RunMatching();
   /// Pairing thread, lock held on entry and exit: computes the data of
@@ -171,7 +210,7 @@ class LoopCloser {
   void QueuePairs();
   /// Lock held: the store's data for `frame`, null (and a problem noted) if
   /// it cannot be read back.
-  std::shared_ptr<const mapping::SubmapMatchData> StoredData(int64_t frame);
+  std::shared_ptr<const mapping::SubmapMatchData> StoredData(const mapping::SubmapId& id);
   bool PairingIdle() const;
 
   const LoopCloserOptions options_;
@@ -181,13 +220,15 @@ class LoopCloser {
   std::condition_variable wake_pairing_;
   std::condition_variable wake_matching_;
   std::condition_variable idle_;
-  std::deque<std::shared_ptr<const mapping::Submap>> waiting_;
+  std::deque<Waiting> waiting_;
   bool preparing_ = false;
-  std::map<int64_t, OptimisedOrigin> origins_;
+  std::map<mapping::SubmapId, OptimisedOrigin> origins_;
   bool origins_changed_ = false;
   mapping::SubmapPairing pairing_;
-  std::map<int64_t, Prepared> prepared_;  ///< by frame id
-  mapping::MatchDataStore store_;         ///< by frame id; suitable submaps only once paired
+  std::map<mapping::SubmapId, Prepared> prepared_;
+  mapping::MatchDataStore store_;   ///< by StoreKey; suitable submaps only once paired
+  std::map<PairKey, int> claimed_;  ///< pairs another rover announced, by the lowest claimant
+  std::vector<PairKey> claims_out_;
   struct QueuedPair {
     mapping::SubmapPair pair;
     std::shared_ptr<const mapping::SubmapMatchData> a;

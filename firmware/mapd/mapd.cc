@@ -18,6 +18,7 @@
 #include "firmware/mapd/submap_archive.h"
 #include "mapping/slam/graph_factor_record.h"
 #include "mapping/slam/graph_log.h"
+#include "mapping/submap/submap_messages.h"
 #include "mapping/tags/tag_log.h"
 
 namespace rover::mapd {
@@ -253,7 +254,7 @@ int Mapd::Poll() {
   if (loop_) TakeLoopMatches();
   if (tags_) TakeTagResults();
   if (team_) {
-    TakeTeamConstraints();
+    TakeTeam();
     if (!waiting_detections_.empty()) RetryWaitingDetections(false);
   }
   if (slam_) TakeSlamSnapshot();
@@ -521,7 +522,10 @@ void Mapd::FinishMappingSubmap() {
     if (r.frame_id == mapping_submap_->frame_id()) record = &r;
   }
   if (record != nullptr && mapping_submap_->images() > 0) {
-    const ArchivedBytes bytes = archive_->Add(*record, *mapping_submap_);
+    mapping::TeamSubmap messages;
+    const ArchivedBytes bytes =
+        archive_->Add(*record, *mapping_submap_, team_ ? &messages : nullptr);
+    if (team_) team_->ShareSubmap(messages, record->last_stamp.nanoseconds());
     stats_.octree_bytes += bytes.octree;
     stats_.cloud_bytes += bytes.cloud;
     ++stats_.submaps_archived;
@@ -670,12 +674,27 @@ void Mapd::RetryWaitingDetections(bool final) {
   }
 }
 
-void Mapd::TakeTeamConstraints() {
-  for (const log::rover_msgs::GraphFactor& msg : team_->Take(newest_stamp_ns_)) {
+void Mapd::TakeTeam() {
+  TeamArrivals arrivals = team_->Take(newest_stamp_ns_);
+  for (const log::rover_msgs::GraphFactor& msg : arrivals.constraints) {
     LogAndSubmit(msg);
     const mapping::GraphFactorRecord f = mapping::FromMsg(msg);  // checked on arrival
     if (f.kind == mapping::FactorKind::kRobotDetection && f.b && f.b->robot == options_.robot_id) {
       AddDetectedPose(f);
+    }
+  }
+  if (!loop_) return;
+  for (const mapping::MatchClaim& c : arrivals.claims) {
+    loop_->AddClaim({c.a.robot, c.a.index}, {c.b.robot, c.b.index}, static_cast<int>(c.claimant));
+  }
+  for (ReceivedSubmap& s : arrivals.submaps) {
+    try {
+      loop_->AddTeamSubmap(
+          {s.robot, s.messages.info.frame_id}, mapping::FromOctomapMsg(s.messages.octomap),
+          std::make_shared<const mapping::PointCloud>(mapping::FromPointCloud2(s.messages.cloud)));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "mapd: team: submap %u of robot %d cannot be read: %s\n",
+                   s.messages.info.frame_id, s.robot, e.what());
     }
   }
 }
@@ -745,9 +764,8 @@ void Mapd::TakeLoopMatches() {
   }
   for (const LoopMatch& m : loop_->TakeMatches()) {
     if (!m.accepted) {
-      std::fprintf(stderr, "mapd: submaps %lld and %lld do not match: %s (%.0f ms)\n",
-                   static_cast<long long>(m.a.index), static_cast<long long>(m.b.index),
-                   m.rejection.c_str(), m.match_ms);
+      std::fprintf(stderr, "mapd: submaps %s and %s do not match: %s (%.0f ms)\n",
+                   m.a.ToString().c_str(), m.b.ToString().c_str(), m.rejection.c_str(), m.match_ms);
       continue;
     }
     // How far the match moves b against the graph's estimate: the size of
@@ -755,10 +773,9 @@ void Mapd::TakeLoopMatches() {
     const Eigen::Isometry3d correction = m.prior.T_a_b.inverse() * m.T_a_b;
     std::fprintf(
         stderr,
-        "mapd: loop closure between submaps %lld and %lld: %.2f m and %.2f deg from the "
+        "mapd: loop closure between submaps %s and %s: %.2f m and %.2f deg from the "
         "graph's estimate, %s, RMSE %.3f m, %.0f ms\n",
-        static_cast<long long>(m.a.index), static_cast<long long>(m.b.index),
-        correction.translation().norm(),
+        m.a.ToString().c_str(), m.b.ToString().c_str(), correction.translation().norm(),
         Eigen::AngleAxisd(correction.linear()).angle() * 180.0 / M_PI,
         m.from_prior ? "aligned from the prior" : (std::to_string(m.inliers) + " inliers").c_str(),
         m.rmse_m, m.match_ms);
@@ -773,6 +790,15 @@ void Mapd::TakeLoopMatches() {
     }
     AddFactor(std::move(factor));
     ++stats_.loop_closures;
+    if (m.a.robot != m.b.robot) ++stats_.inter_robot_closures;
+  }
+  if (team_) {
+    for (const auto& [a, b] : loop_->TakeClaims()) {
+      team_->ShareClaim(
+          {mapping::GraphKey::Origin(a.robot, a.index), mapping::GraphKey::Origin(b.robot, b.index),
+           static_cast<uint32_t>(options_.robot_id)},
+          newest_stamp_ns_);
+    }
   }
 }
 
@@ -987,7 +1013,7 @@ void Mapd::TakeSlamSnapshot() {
   if (snap.origins_update != last_origins_update_) {
     last_origins_update_ = snap.origins_update;
     PublishOrigins(snap);
-    if (loop_) loop_->UpdateOrigins(snap.origins);
+    if (loop_) loop_->UpdateOrigins(snap.origins, snap.team_origins);
     if (archive_) LogOrigins(snap);
   }
   if (snap.T_world_body) {
@@ -1062,7 +1088,7 @@ void Mapd::Shutdown() {
     ApplyTagDecisions(tag_resolver_.Expire(newest_tag_stamp_ns_, true));
   }
   if (team_) {
-    TakeTeamConstraints();
+    TakeTeam();
     RetryWaitingDetections(true);
   }
   if (slam_) {
@@ -1129,6 +1155,11 @@ void Mapd::Shutdown() {
     graph["team_link_bytes_received"] = std::to_string(t.worker.link.received_bytes);
     graph["team_link_bytes_per_s"] = std::to_string(t.link_bytes_per_s);
     graph["team_robot_detections"] = std::to_string(stats_.robot_detections);
+    graph["team_inter_robot_closures"] = std::to_string(stats_.inter_robot_closures);
+    graph["team_submaps_shared"] = std::to_string(t.submaps_shared);
+    graph["team_submap_bytes_shared"] = std::to_string(t.submap_bytes_shared);
+    graph["team_submaps_received"] = std::to_string(t.submaps_received);
+    graph["team_submaps_refused"] = std::to_string(t.submaps_refused);
     graph["team_detected_poses"] = std::to_string(stats_.detected_poses);
     graph["team_detected_poses_unplaced"] = std::to_string(stats_.detected_poses_unplaced);
     graph["team_duplicate_fragments"] = std::to_string(t.worker.sync.duplicate_fragments);
@@ -1229,6 +1260,16 @@ std::string Mapd::Summary() const {
                   l.store.submaps, static_cast<double>(l.store.spilled_bytes) / 1e6,
                   static_cast<unsigned long long>(l.store.spill_reads));
     out += text;
+    if (team_) {
+      std::snprintf(text, sizeof(text),
+                    "    with the team: %llu submaps from other rovers, %llu pairs with them "
+                    "matched here, %llu accepted, %llu left to the rover that claimed them\n",
+                    static_cast<unsigned long long>(l.team_submaps),
+                    static_cast<unsigned long long>(l.team_pairs_matched),
+                    static_cast<unsigned long long>(l.team_matches_accepted),
+                    static_cast<unsigned long long>(l.pairs_claimed_by_others));
+      out += text;
+    }
   }
   if (tags_) {
     const TagWorkerStats t = tags_->Stats();

@@ -163,6 +163,7 @@ struct MapdStats {
   uint64_t graph_factors_refused = 0;   ///< malformed before reaching the graph (NaN, ...)
   uint64_t graph_factors_resumed = 0;   ///< taken over from the previous mapd's log
   uint64_t loop_closures = 0;           ///< accepted matches added to the graph
+  uint64_t inter_robot_closures = 0;    ///< of those, with another rover's submap
   // AprilTags (the tag thread's own counts are in tag_stats()).
   uint64_t tag_observations_logged = 0;
   uint64_t tag_sightings = 0;           ///< pose nodes (v) of images with landmark tags
@@ -265,8 +266,9 @@ class Mapd {
   /// Starts the team exchange (with options.team) once the resume is
   /// decided: a resumed log's team messages are what this rover already has.
   void StartTeam(const mapping::GraphLogContents* resumed);
-  /// Adds the other rovers' constraints that arrived to the graph.
-  void TakeTeamConstraints();
+  /// Takes what the team sent: constraints into the graph, claims and
+  /// submaps to the loop closer.
+  void TakeTeam();
   /// Anchors the graph at `frame_id` (once): the world frame of this rover.
   void EnsurePrior(uint32_t frame_id, int64_t stamp_ns);
   /// Takes a new graph snapshot: moves the composed submaps, logs it.

@@ -151,7 +151,7 @@ void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch, bool 
   }
   if (ok) {
     for (const mapping::GraphKey& key : graph_.Keys()) {
-      if (key.type != mapping::GraphKey::Type::kOrigin || key.robot != robot_) continue;
+      if (key.type != mapping::GraphKey::Type::kOrigin) continue;
       OptimisedOrigin o;
       try {
         o.T_world_origin = graph_.Estimate(key);
@@ -163,7 +163,11 @@ void SlamWorker::UpdateOnce(std::deque<mapping::GraphFactorRecord>* batch, bool 
       } catch (const std::exception&) {
         // Not computed (option off): left zero.
       }
-      snap.origins[key.index] = o;
+      if (key.robot == robot_) {
+        snap.origins[key.index] = o;
+      } else {
+        snap.team_origins[mapping::SubmapId{key.robot, key.index}] = o;
+      }
     }
     if (pose) {
       const auto origin = snap.origins.find(pose->frame_id);

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "mapping/graph/rover_graph.h"
+#include "mapping/loop/submap_id.h"
 #include "mapping/slam/graph_factor_record.h"
 
 namespace rover::mapd {
@@ -40,8 +41,11 @@ struct SlamSnapshot {
   /// idle-time step moved them); later updates only moved the global pose.
   uint64_t origins_update = 0;
   int64_t stamp_ns = 0;  ///< of the newest factor or pose it includes
-  /// By the filter's local frame id (robot 0's origins).
+  /// This rover's origins, by the filter's local frame id.
   std::map<int64_t, OptimisedOrigin> origins;
+  /// In a team: the other rovers' origins that the graph has placed (linked
+  /// to this rover's map), by robot and frame.
+  std::map<mapping::SubmapId, OptimisedOrigin> team_origins;
   std::optional<Eigen::Isometry3d> T_world_body;  ///< s_j (+) v_t
   int64_t global_pose_stamp_ns = 0;
   uint32_t global_pose_frame_id = 0;

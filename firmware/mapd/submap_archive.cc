@@ -49,42 +49,44 @@ void SubmapArchive::OpenFrame(const SubmapRecord& record) {
   T_map_frame_[record.frame_id] = previous->second * TransformOf(*record.origin);
 }
 
-ArchivedBytes SubmapArchive::Add(const SubmapRecord& record, const mapping::Submap& submap) {
+ArchivedBytes SubmapArchive::Add(const SubmapRecord& record, const mapping::Submap& submap,
+                                 mapping::TeamSubmap* messages) {
   ArchivedBytes bytes;
   log::std_msgs::Header header;
   header.stamp = log::ToRosTime(record.last_stamp);
   header.frame_id =
       log::FrameId::Truncated("local/" + robot_name_ + "/" + std::to_string(submap.frame_id()));
-  const log::octomap_msgs::Octomap octomap = mapping::ToOctomapMsg(submap.octree(), header);
-  const log::sensor_msgs::PointCloud2 points = mapping::ToPointCloud2(submap.cloud(), header);
-  bytes.octree = log::SerializedSize(octomap);
-  bytes.cloud = log::SerializedSize(points);
-
+  mapping::TeamSubmap m;
+  m.octomap = mapping::ToOctomapMsg(submap.octree(), header);
+  m.cloud = mapping::ToPointCloud2(submap.cloud(), header);
+  bytes.octree = log::SerializedSize(m.octomap);
+  bytes.cloud = log::SerializedSize(m.cloud);
+  log::rover_msgs::SubmapInfo& info = m.info;
+  info.header = header;
+  info.index = record.index;
+  info.frame_id = record.frame_id;
+  if (record.origin) {
+    info.has_origin = true;
+    info.previous_frame_id = record.origin->old_frame_id;
+    info.origin_stamp_ns = record.origin->stamp_ns;
+    info.p_previous_origin_m = record.origin->p_old_new_m;
+    info.yaw_previous_origin_rad = record.origin->yaw_old_new_rad;
+    info.origin_covariance = record.origin->covariance;
+  }
+  info.first_stamp_ns = record.first_stamp.nanoseconds();
+  info.last_stamp_ns = record.last_stamp.nanoseconds();
+  info.images = static_cast<uint32_t>(submap.images());
+  info.distance_m = record.distance_m;
+  info.octree_bytes = bytes.octree;
+  info.cloud_bytes = bytes.cloud;
   if (log_) {
-    log::rover_msgs::SubmapInfo info;
-    info.header = header;
-    info.index = record.index;
-    info.frame_id = record.frame_id;
-    if (record.origin) {
-      info.has_origin = true;
-      info.previous_frame_id = record.origin->old_frame_id;
-      info.origin_stamp_ns = record.origin->stamp_ns;
-      info.p_previous_origin_m = record.origin->p_old_new_m;
-      info.yaw_previous_origin_rad = record.origin->yaw_old_new_rad;
-      info.origin_covariance = record.origin->covariance;
-    }
-    info.first_stamp_ns = record.first_stamp.nanoseconds();
-    info.last_stamp_ns = record.last_stamp.nanoseconds();
-    info.images = static_cast<uint32_t>(submap.images());
-    info.distance_m = record.distance_m;
-    info.octree_bytes = bytes.octree;
-    info.cloud_bytes = bytes.cloud;
     const int64_t t = record.last_stamp.nanoseconds();
     log_->Write("/mapd/submap/info", t, info);
-    log_->Write("/mapd/submap/octomap", t, octomap);
-    log_->Write("/mapd/submap/cloud", t, points);
+    log_->Write("/mapd/submap/octomap", t, m.octomap);
+    log_->Write("/mapd/submap/cloud", t, m.cloud);
     log_->Flush();  // a crash from here on keeps this submap
   }
+  if (messages != nullptr) *messages = std::move(m);
 
   // The origin may have arrived after the record was opened (topics are not
   // ordered): chain it now.

@@ -32,6 +32,7 @@
 #include "firmware/mapd/map_log.h"
 #include "mapping/compose/map_composer.h"
 #include "mapping/submap/submap.h"
+#include "mapping/team/team_submap.h"
 
 namespace rover::mapd {
 
@@ -58,8 +59,10 @@ class SubmapArchive {
   /// places submaps in the map frame (the first record's frame).
   void OpenFrame(const SubmapRecord& record);
   /// Logs `submap` (finished) with its record. Returns the serialised sizes
-  /// of its octree and cloud messages.
-  ArchivedBytes Add(const SubmapRecord& record, const mapping::Submap& submap);
+  /// of its octree and cloud messages; `messages` (if given) gets the three
+  /// messages as logged (for the team).
+  ArchivedBytes Add(const SubmapRecord& record, const mapping::Submap& submap,
+                    mapping::TeamSubmap* messages = nullptr);
   /// Logs the traversability grid.
   void LogTraversability(const log::nav_msgs::OccupancyGrid& grid);
   /// Logs one pose-graph factor and flushes it to disk (a crash from then on

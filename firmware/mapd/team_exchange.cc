@@ -8,6 +8,7 @@
 #include "core/log/msgs/message_traits.h"
 #include "firmware/mapd/submap_archive.h"
 #include "mapping/team/team_message.h"
+#include "mapping/team/team_submap.h"
 
 namespace rover::mapd {
 namespace {
@@ -107,24 +108,66 @@ std::string TeamExchange::Check(const mapping::GraphFactorRecord& record) const 
   return {};
 }
 
-std::vector<log::rover_msgs::GraphFactor> TeamExchange::Take(int64_t stamp_ns) {
+void TeamExchange::ShareSubmap(const mapping::TeamSubmap& submap, int64_t stamp_ns) {
+  std::vector<uint8_t> bytes = mapping::EncodeSubmap(submap);
+  const uint64_t seq = ++sent_[mapping::TeamStream::kSubmaps];
+  Log(mapping::kTeamSentTopic, self_, mapping::TeamStream::kSubmaps, seq, bytes, stamp_ns);
+  ++stats_.submaps_shared;
+  stats_.submap_bytes_shared += bytes.size();
+  worker_->PublishSubmap(std::move(bytes));
+}
+
+void TeamExchange::ShareClaim(const mapping::MatchClaim& claim, int64_t stamp_ns) {
+  worker_->PublishClaim(claim);
+  const uint64_t seq = ++sent_[mapping::TeamStream::kMatchClaims];
+  Log(mapping::kTeamSentTopic, self_, mapping::TeamStream::kMatchClaims, seq,
+      mapping::EncodeMatchClaim(claim), stamp_ns);
+  ++stats_.claims_shared;
+}
+
+void TeamExchange::Refuse(const std::string& what, const std::string& why) {
+  stats_.last_refusal = what + " refused: " + why;
+  std::fprintf(stderr, "mapd: team: %s\n", stats_.last_refusal.c_str());
+}
+
+TeamArrivals TeamExchange::Take(int64_t stamp_ns) {
   TeamInbox inbox = worker_->Take();
   for (const TeamRecord& r : inbox.records) {
     Log(mapping::kTeamReceivedTopic, static_cast<int32_t>(r.origin), r.stream, r.seq, r.bytes,
         stamp_ns);
   }
-  std::vector<log::rover_msgs::GraphFactor> out;
+  TeamArrivals out;
   for (std::size_t k = 0; k < inbox.constraints.size(); ++k) {
     const std::string refusal = Check(inbox.constraints[k]);
     if (!refusal.empty()) {
       ++stats_.constraints_refused;
-      stats_.last_refusal = "constraint " + inbox.constraints[k].Describe() + " (id " +
-                            std::to_string(inbox.constraints[k].id) + ") refused: " + refusal;
-      std::fprintf(stderr, "mapd: team: %s\n", stats_.last_refusal.c_str());
+      Refuse("constraint " + inbox.constraints[k].Describe() + " (id " +
+                 std::to_string(inbox.constraints[k].id) + ")",
+             refusal);
       continue;
     }
     ++stats_.constraints_received;
-    out.push_back(std::move(inbox.constraint_messages[k]));
+    out.constraints.push_back(std::move(inbox.constraint_messages[k]));
+  }
+  for (const mapping::MatchClaim& claim : inbox.claims) {
+    ++stats_.claims_received;
+    out.claims.push_back(claim);
+  }
+  for (const TeamRecord& r : inbox.submaps) {
+    const std::string what =
+        "submap message " + std::to_string(r.seq) + " of robot " + std::to_string(r.origin);
+    if (!team_.empty() && team_.count(static_cast<int>(r.origin)) == 0) {
+      ++stats_.submaps_refused;
+      Refuse(what, "that robot is not in the team");
+      continue;
+    }
+    try {
+      out.submaps.push_back({static_cast<int>(r.origin), mapping::DecodeSubmap(r.bytes)});
+      ++stats_.submaps_received;
+    } catch (const mapping::TeamMessageError& e) {
+      ++stats_.submaps_refused;
+      Refuse(what, e.what());
+    }
   }
   return out;
 }
@@ -157,6 +200,16 @@ std::string TeamExchange::Summary() const {
       static_cast<unsigned long long>(s.worker.undecodable),
       static_cast<unsigned long long>(s.messages_resumed));
   std::string out = text;
+  std::snprintf(text, sizeof(text),
+                "    submaps: %llu shared (%.1f KB compressed), %llu received, %llu refused; "
+                "match claims: %llu shared, %llu received\n",
+                static_cast<unsigned long long>(s.submaps_shared),
+                static_cast<double>(s.submap_bytes_shared) / 1e3,
+                static_cast<unsigned long long>(s.submaps_received),
+                static_cast<unsigned long long>(s.submaps_refused),
+                static_cast<unsigned long long>(s.claims_shared),
+                static_cast<unsigned long long>(s.claims_received));
+  out += text;
   if (!s.last_refusal.empty()) out += "    last refused: " + s.last_refusal + "\n";
   if (!s.worker.last_decode_error.empty()) {
     out += "    last undecodable: " + s.worker.last_decode_error + "\n";

@@ -23,10 +23,26 @@
 #include "core/link/link_endpoint.h"
 #include "firmware/mapd/team_worker.h"
 #include "mapping/slam/graph_log.h"
+#include "mapping/team/team_message.h"
+#include "mapping/team/team_submap.h"
 
 namespace rover::mapd {
 
 class SubmapArchive;
+
+/// Another rover's finished submap, decoded and checked.
+struct ReceivedSubmap {
+  int robot = 0;
+  mapping::TeamSubmap messages;
+};
+
+/// What arrived from the team since the last Take.
+struct TeamArrivals {
+  /// The other rovers' constraints, checked, in arrival order.
+  std::vector<log::rover_msgs::GraphFactor> constraints;
+  std::vector<mapping::MatchClaim> claims;
+  std::vector<ReceivedSubmap> submaps;
+};
 
 /// Counters of the team exchange.
 struct TeamExchangeStats {
@@ -34,6 +50,12 @@ struct TeamExchangeStats {
   uint64_t constraints_received = 0;  ///< the others' factors added to this graph
   uint64_t constraints_refused = 0;   ///< received but refused (see last_refusal)
   uint64_t messages_resumed = 0;      ///< taken over from the previous mapd's log
+  uint64_t submaps_shared = 0;
+  uint64_t submap_bytes_shared = 0;  ///< compressed, as sent
+  uint64_t submaps_received = 0;
+  uint64_t submaps_refused = 0;  ///< did not decode (damage, checksum); see last_refusal
+  uint64_t claims_shared = 0;
+  uint64_t claims_received = 0;
   /// Bytes this rover sent on the link per second of wall time since the
   /// exchange started (the radio's view: summaries, resends and all).
   double link_bytes_per_s = 0.0;
@@ -59,9 +81,12 @@ class TeamExchange {
   /// Shares one factor of this rover's graph, as logged (priors stay home:
   /// each rover anchors its own map). `stamp_ns` is the log time.
   void Share(const log::rover_msgs::GraphFactor& msg, int64_t stamp_ns);
-  /// The other rovers' constraints that arrived since the last call, logged
-  /// and checked, in arrival order.
-  std::vector<log::rover_msgs::GraphFactor> Take(int64_t stamp_ns);
+  /// Shares one of this rover's finished submaps (compressed, sent once).
+  void ShareSubmap(const mapping::TeamSubmap& submap, int64_t stamp_ns);
+  /// Announces that this rover matches the pair (a, b).
+  void ShareClaim(const mapping::MatchClaim& claim, int64_t stamp_ns);
+  /// What the other rovers sent since the last call, logged and checked.
+  TeamArrivals Take(int64_t stamp_ns);
   /// This rover's latest global pose for the others.
   void SetHeartbeat(const mapping::TeamHeartbeat& heartbeat);
 
@@ -74,6 +99,8 @@ class TeamExchange {
  private:
   void Log(std::string_view topic, int32_t origin, mapping::TeamStream stream, uint64_t seq,
            const std::vector<uint8_t>& bytes, int64_t stamp_ns);
+  /// Counts nothing; keeps and prints the reason.
+  void Refuse(const std::string& what, const std::string& why);
   /// Empty if `record` may join the graph, else why not.
   std::string Check(const mapping::GraphFactorRecord& record) const;
 
