@@ -258,3 +258,76 @@ TEST(LoopCloserOptionsTest, InvalidOptionsNameTheKey) {
 
 }  // namespace
 }  // namespace rover::mapd
+
+namespace rover::mapd {
+namespace {
+
+// Another rover's submap, as the team link delivers it (octree and cloud).
+void HandOverAsTeamSubmap(LoopCloser* closer, int robot, uint32_t frame, SyntheticSubmap s) {
+  closer->AddTeamSubmap({robot, frame}, std::make_shared<const octomap::OcTree>(s.submap->octree()),
+                        std::make_shared<const mapping::PointCloud>(s.submap->cloud()));
+}
+
+// Rover 1 drove frames 1 and 2; rover 0's frame 3 revisits rover 1's frame 1.
+std::map<mapping::SubmapId, OptimisedOrigin> TeamOrigins(
+    const std::map<int64_t, OptimisedOrigin>& drifted) {
+  return {{mapping::SubmapId{0, 3}, drifted.at(3)}};
+}
+
+TEST_F(LoopCloserTest, AnotherRoversSubmapIsMatchedWithThisRoversFirstAndClaimed) {
+  LoopCloser closer({}, 1);
+  for (uint32_t frame : {1u, 2u}) closer.AddSubmap(Take(Render(frame)));
+  HandOverAsTeamSubmap(&closer, 0, 3, Render(3));
+  std::map<int64_t, OptimisedOrigin> own = DriftedOrigins();
+  const std::map<mapping::SubmapId, OptimisedOrigin> team = TeamOrigins(own);
+  own.erase(3);
+  closer.UpdateOrigins(own, team);
+  closer.Flush();
+  const std::vector<LoopMatch> matches = closer.TakeMatches();
+  ASSERT_EQ(matches.size(), 1u);
+  const LoopMatch& m = matches.front();
+  EXPECT_EQ(m.a, (mapping::SubmapId{1, 1})) << "this rover's submap first";
+  EXPECT_EQ(m.b, (mapping::SubmapId{0, 3}));
+  ASSERT_TRUE(m.accepted) << m.rejection;
+  const mapping::testing::PoseError e =
+      mapping::testing::ErrorOf(m.T_a_b, Truth(1).inverse() * Truth(3));
+  EXPECT_LT(e.translation_m, 0.2);
+  EXPECT_LT(e.rotation_rad, 1.0 * kDeg);
+  const auto claims = closer.TakeClaims();
+  ASSERT_EQ(claims.size(), 1u);
+  EXPECT_EQ(claims[0], (std::pair{mapping::SubmapId{0, 3}, mapping::SubmapId{1, 1}}));
+  const LoopCloserStats stats = closer.Stats();
+  EXPECT_EQ(stats.team_submaps, 1u);
+  EXPECT_EQ(stats.team_pairs_matched, 1u);
+  EXPECT_EQ(stats.team_matches_accepted, 1u);
+}
+
+TEST_F(LoopCloserTest, APairAnotherRoverClaimedIsLeftToIt) {
+  LoopCloser closer({}, 1);
+  closer.AddClaim({1, 1}, {0, 3}, 0);
+  for (uint32_t frame : {1u, 2u}) closer.AddSubmap(Take(Render(frame)));
+  HandOverAsTeamSubmap(&closer, 0, 3, Render(3));
+  std::map<int64_t, OptimisedOrigin> own = DriftedOrigins();
+  const std::map<mapping::SubmapId, OptimisedOrigin> team = TeamOrigins(own);
+  own.erase(3);
+  closer.UpdateOrigins(own, team);
+  closer.Flush();
+  EXPECT_TRUE(closer.TakeMatches().empty());
+  EXPECT_TRUE(closer.TakeClaims().empty());
+  EXPECT_EQ(closer.Stats().pairs_claimed_by_others, 1u);
+}
+
+TEST_F(LoopCloserTest, TwoOtherRoversSubmapsAreTheirsToMatch) {
+  LoopCloser closer({}, 2);
+  HandOverAsTeamSubmap(&closer, 0, 1, Render(1));
+  HandOverAsTeamSubmap(&closer, 1, 3, Render(3));
+  const std::map<int64_t, OptimisedOrigin> drifted = DriftedOrigins();
+  closer.UpdateOrigins(
+      {}, {{mapping::SubmapId{0, 1}, drifted.at(1)}, {mapping::SubmapId{1, 3}, drifted.at(3)}});
+  closer.Flush();
+  EXPECT_TRUE(closer.TakeMatches().empty());
+  EXPECT_EQ(closer.Stats().pairs_matched, 0u);
+}
+
+}  // namespace
+}  // namespace rover::mapd

@@ -212,3 +212,61 @@ TEST(MapdTeamTest, ARestartedMapdCarriesOnFromItsLogAndNothingArrivesTwice) {
 
 }  // namespace
 }  // namespace rover::mapd
+
+namespace rover::mapd {
+namespace {
+
+mapping::TeamSubmap SmallSubmap(uint32_t frame) {
+  mapping::TeamSubmap s;
+  s.info.frame_id = frame;
+  s.info.index = frame;
+  s.octomap.id = "OcTree";
+  s.octomap.resolution = 0.1;
+  s.octomap.data.assign(5000, 0);
+  s.cloud.height = 1;
+  s.cloud.data.assign(3000, 7);
+  return s;
+}
+
+template <typename F>
+bool Wait(F done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (std::chrono::steady_clock::now() < end) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+TEST(TeamExchangeTest, SubmapsAndClaimsArriveDecodedAndADamagedSubmapIsRefused) {
+  TeamExchange a(0, Endpoint(0), Team(), nullptr, nullptr);
+  TeamExchange b(1, Endpoint(1), Team(), nullptr, nullptr);
+  TeamWorker raw(Endpoint(1), Team());  // another process claiming to be robot 1
+  a.ShareSubmap(SmallSubmap(4), 0);
+  a.ShareClaim({mapping::GraphKey::Origin(0, 4), mapping::GraphKey::Origin(1, 2), 0}, 0);
+  TeamArrivals got;
+  ASSERT_TRUE(Wait([&] {
+    TeamArrivals in = b.Take(0);
+    for (auto& s : in.submaps) got.submaps.push_back(std::move(s));
+    for (auto& c : in.claims) got.claims.push_back(c);
+    return got.submaps.size() == 1 && got.claims.size() == 1;
+  }));
+  EXPECT_EQ(got.submaps[0].robot, 0);
+  EXPECT_EQ(got.submaps[0].messages.info.frame_id, 4u);
+  EXPECT_EQ(got.submaps[0].messages.octomap.data.size(), 5000u);
+  EXPECT_EQ(got.claims[0].b, mapping::GraphKey::Origin(1, 2));
+
+  std::vector<uint8_t> damaged = mapping::EncodeSubmap(SmallSubmap(5));
+  damaged[damaged.size() - 6] ^= 0x40;
+  raw.PublishSubmap(damaged);
+  ASSERT_TRUE(Wait([&] {
+    a.Take(0);
+    return a.Stats().submaps_refused == 1;
+  }));
+  EXPECT_NE(a.Stats().last_refusal.find("team submap"), std::string::npos)
+      << a.Stats().last_refusal;
+  EXPECT_EQ(a.Stats().submaps_received, 0u);
+}
+
+}  // namespace
+}  // namespace rover::mapd
