@@ -367,7 +367,15 @@ struct TeamSync::Impl {
     const std::optional<Fragment> f = ParseFragment(sender, r);
     if (!f) return;
     Stream& st = store[f->key];
-    if (st.complete.count(f->seq) != 0) {
+    const auto held = st.complete.find(f->seq);
+    if (held != st.complete.end()) {
+      if (held->second.crc != f->crc) {
+        // The same number with other contents: two rovers send under one id.
+        Refuse(f->what + ": differs from the message held under that number (robot " +
+                   std::to_string(f->key.origin) + "'s id used by two rovers?)",
+               sender);
+        return;
+      }
       ++stats->duplicate_fragments;
       return;
     }

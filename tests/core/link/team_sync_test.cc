@@ -307,6 +307,8 @@ TEST(TeamSyncTest, BadDatagramsAreRefusedWithTheReasonAndNothingHeldIsLost) {
       {FragmentBytes(1, 2, 3, message, crc), "own id"},
       {FragmentBytes(9, 9, 1, message, crc), "not in the team"},
       {FragmentBytes(2, 2, 3, message, crc ^ 1u), "does not match"},
+      // Message 1 is held with other contents: a second rover under id 2.
+      {FragmentBytes(2, 2, 1, message, crc), "id used by two rovers"},
   };
   for (const Case& c : cases) {
     const uint64_t refused = team[1].stats().refused_datagrams;
