@@ -32,6 +32,7 @@
 #include "mapping/graph/rover_graph.h"
 #include "mapping/slam/false_match_injection.h"
 #include "mapping/slam/graph_log.h"
+#include "mapping/slam/team_graph.h"
 #include "mapping/tags/tag_log.h"
 
 namespace rover::sim::experiments {
@@ -694,6 +695,128 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
          << " loop closures (" << r.loop_closures_valid << " within 0.2 m and 1 deg of the truth), "
          << r.graph_origins << " submaps at the graph's origins; match " << Num(r.matcher_ms_p50, 1)
          << " ms p50, graph update " << Num(r.graph_update_ms_p99, 1) << " ms p99\n";
+  return r;
+}
+
+TeamMapResult EvaluateTeamMap(const std::vector<TeamMapRover>& rovers, std::ostream& report,
+                              const MapQualityOptions& quality) {
+  if (rovers.empty()) throw std::runtime_error("team map: no rovers");
+  std::vector<MissionFacts> missions;
+  for (const TeamMapRover& r : rovers) missions.push_back(ReadMission(r.mission_log));
+  const MissionFacts& first = missions.front();
+  const sim::Scenario scenario = sim::LoadScenario(
+      sim::FindScenario(sim::DefaultScenarioDir(), first.scenario), sim::DefaultSimConfigDir());
+  const sim::World world = sim::World::Generate(scenario.world, first.seed);
+  const sim::TeamRovers team = sim::MakeTeamRovers(scenario, world);
+  std::vector<std::string> all_logs;
+  for (const TeamMapRover& r : rovers) {
+    all_logs.insert(all_logs.end(), r.mapd_logs.begin(), r.mapd_logs.end());
+  }
+  const mapping::TeamGraphSolution graph = mapping::SolveTeamGraph(all_logs);
+  for (const std::string& p : graph.problems) report << "    team graph: " << p << "\n";
+  // The anchor rover's frame 0 in the world, as for its own map.
+  std::size_t anchor = rovers.size();
+  for (std::size_t k = 0; k < rovers.size(); ++k) {
+    if (static_cast<int>(missions[k].rover) == graph.anchor_robot) anchor = k;
+  }
+  if (anchor == rovers.size()) {
+    throw std::runtime_error("team map: no mission log of robot " +
+                             std::to_string(graph.anchor_robot) + ", whose prior anchors the team");
+  }
+  const MissionFacts& m0 = missions[anchor];
+  const sim::TrajectorySample truth0 =
+      team.trajectories[m0.rover].Evaluate((m0.init_stamp - m0.start).ToSeconds());
+  const Eigen::Isometry3d T_world_local0 =
+      FourDof(truth0.p_world_body, truth0.q_world_body.toRotationMatrix()) *
+      FourDof(m0.T_local0_body_init.translation(), m0.T_local0_body_init.linear()).inverse();
+  std::map<uint32_t, Eigen::Isometry3d> frames0 =
+      mapping::ReadFrameOrigins(rovers[anchor].mission_log);
+  // The anchor's prior frame: its lowest origin in the solution.
+  int64_t prior_frame = -1;
+  for (const auto& [key, T] : graph.origins) {
+    if (key.first == graph.anchor_robot && (prior_frame < 0 || key.second < prior_frame)) {
+      prior_frame = key.second;
+    }
+  }
+  const auto chained = frames0.find(static_cast<uint32_t>(prior_frame));
+  if (chained == frames0.end()) throw std::runtime_error("team map: the anchor's frame is unknown");
+  const Eigen::Isometry3d T_world_graph =
+      T_world_local0 * chained->second *
+      graph.origins.at({graph.anchor_robot, prior_frame}).inverse();
+
+  TeamMapResult r;
+  r.unplaced_robots = graph.unplaced_robots;
+  mapping::MapComposer composer;
+  std::vector<Eigen::Isometry3d> cameras;
+  const RectifiedHead head = RectifiedHeadOf(scenario.camera);
+  uint32_t id = 0;
+  std::vector<std::vector<mapping::SubmapLog>> kept(rovers.size());
+  for (std::size_t k = 0; k < rovers.size(); ++k) {
+    const int robot = static_cast<int>(missions[k].rover);
+    std::map<uint32_t, Eigen::Isometry3d> origins;
+    for (const auto& [key, T] : graph.origins) {
+      if (key.first == robot) origins[static_cast<uint32_t>(key.second)] = T_world_graph * T;
+    }
+    for (const std::string& path : rovers[k].mapd_logs) {
+      kept[k].push_back(mapping::ReadSubmapLog(path));
+    }
+    const mapping::SubmapPlacements placements = mapping::PlaceLoggedSubmaps(kept[k], origins);
+    for (const mapping::SubmapLog& l : kept[k]) r.submaps += l.submaps.size();
+    for (const mapping::SubmapPlacement& p : placements.placed) {
+      const mapping::LoggedSubmap& s = kept[k][p.log].submaps[p.submap];
+      composer.SetSubmap(id++, s.octree, s.cloud, p.T_map_submap);
+      ++r.submaps_placed;
+    }
+    report << "  " << team.names[missions[k].rover] << " (robot " << robot
+           << "): " << placements.placed.size() << " submaps placed, " << placements.unplaced.size()
+           << " not";
+    // Where the team put this rover's map against where it is: its frames'
+    // true origins (its own frame 0 in the world, chained by its switches).
+    const MissionFacts& m = missions[k];
+    const sim::TrajectorySample t0 =
+        team.trajectories[m.rover].Evaluate((m.init_stamp - m.start).ToSeconds());
+    const Eigen::Isometry3d T_world_own0 =
+        FourDof(t0.p_world_body, t0.q_world_body.toRotationMatrix()) *
+        FourDof(m.T_local0_body_init.translation(), m.T_local0_body_init.linear()).inverse();
+    const std::map<uint32_t, Eigen::Isometry3d> own_frames =
+        mapping::ReadFrameOrigins(rovers[k].mission_log);
+    std::vector<double> errors_m, errors_deg;
+    for (const auto& [frame, T_world_origin] : origins) {
+      const auto t = own_frames.find(frame);
+      if (t == own_frames.end()) continue;
+      const Eigen::Isometry3d e = (T_world_own0 * t->second).inverse() * T_world_origin;
+      errors_m.push_back(e.translation().norm());
+      errors_deg.push_back(std::abs(YawOf(e.linear())) * 180.0 / M_PI);
+    }
+    if (!errors_m.empty()) {
+      report << "; origins vs truth: median " << Num(stats::Percentile(errors_m, 50.0), 3) << " m, "
+             << Num(stats::Percentile(errors_deg, 50.0), 2) << " deg (max "
+             << Num(*std::max_element(errors_m.begin(), errors_m.end()), 3) << " m)";
+    }
+    report << "\n";
+    const sim::RoverTrajectory& trajectory = team.trajectories[missions[k].rover];
+    for (Time t = missions[k].init_stamp; t <= missions[k].last_stamp;
+         t = t + Duration::FromSeconds(0.25)) {
+      const sim::TrajectorySample s = trajectory.Evaluate((t - missions[k].start).ToSeconds());
+      Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+      T_world_body.linear() = s.q_world_body.toRotationMatrix();
+      T_world_body.translation() = s.p_world_body;
+      cameras.push_back(T_world_body * head.T_body_cam0rect);
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const octomap::OcTree& map = composer.Compose();
+  const mapping::PointCloud cloud = composer.ComposedCloud();
+  r.compose_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  sim::ObstacleRuleOptions rule;
+  rule.rock_min_height_m = rule.step_height_m;  // as for one rover's map
+  const sim::ObstacleGrid obstacles = sim::ComputeObstacleCells(world, rule);
+  r.quality = EvaluateMap(world, obstacles, rule, map, cloud, cameras, head.stereo, quality);
+  report << "  team map: " << r.submaps_placed << " of " << r.submaps << " submaps placed ("
+         << graph.factors << " factors, " << graph.priors_left_out << " other priors left out, "
+         << r.unplaced_robots.size() << " rovers unlinked); occupancy precision "
+         << Num(r.quality.map_precision, 3) << ", recall " << Num(r.quality.map_recall, 3) << "\n";
   return r;
 }
 

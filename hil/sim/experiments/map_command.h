@@ -98,6 +98,27 @@ struct MapResult {
   double slam_alone_error_pct = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// One rover of a team mission: its flight log and its mapd logs.
+struct TeamMapRover {
+  std::string mission_log;
+  std::vector<std::string> mapd_logs;
+};
+
+/// The team's map: every rover's submaps at the team graph's origins
+/// (mapping::SolveTeamGraph over all mapd logs, in the lowest robot's frame),
+/// scored against the world like one rover's map.
+struct TeamMapResult {
+  MapQuality quality;
+  uint64_t submaps = 0;
+  uint64_t submaps_placed = 0;
+  std::vector<int> unplaced_robots;  ///< no factor linked them to the anchor
+  double compose_ms = 0.0;
+};
+
+/// Throws std::runtime_error naming the file or the problem.
+TeamMapResult EvaluateTeamMap(const std::vector<TeamMapRover>& rovers, std::ostream& report,
+                              const MapQualityOptions& quality = {});
+
 /// Evaluates; throws std::runtime_error naming the file or the problem.
 MapResult EvaluateMission(const MapCommandOptions& options, std::ostream& report);
 

@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "hil/sim/experiments/map_command.h"
 #include "mapping/compose/submap_log.h"
 #include "mapping/slam/graph_log.h"
 
@@ -15,12 +16,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> MapdLogs(const std::string& folder) {
+// The logs in `folder` whose name starts with `prefix`, sorted.
+std::vector<std::string> Logs(const std::string& folder, const std::string& prefix) {
   std::vector<std::string> out;
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
-    if (name.rfind("mapd-", 0) == 0 && entry.path().extension() == ".mcap") {
+    if (name.rfind(prefix, 0) == 0 && entry.path().extension() == ".mcap") {
       out.push_back(entry.path().string());
     }
   }
@@ -65,7 +67,7 @@ TeamResult EvaluateTeam(const std::string& scenario, const std::vector<TeamRover
   TeamResult r;
   std::vector<std::string> all_logs;
   for (const TeamRoverRun& run : runs) {
-    const std::vector<std::string> logs = MapdLogs(run.folder);
+    const std::vector<std::string> logs = Logs(run.folder, "mapd-");
     all_logs.insert(all_logs.end(), logs.begin(), logs.end());
     double link_bytes_per_s = std::nan("");
     std::string received = "0";
@@ -113,13 +115,33 @@ TeamResult EvaluateTeam(const std::string& scenario, const std::vector<TeamRover
          << r.robot_detections << " robot detections, " << r.shared_landmark_sightings
          << " sightings of shared landmarks\n";
   for (const std::string& p : graph.problems) report << "    problem: " << p << "\n";
+  std::vector<TeamMapRover> map_rovers;
+  for (const TeamRoverRun& run : runs) {
+    const std::vector<std::string> missions = Logs(run.folder, "mission-");
+    if (missions.size() != 1) continue;
+    map_rovers.push_back({missions.front(), Logs(run.folder, "mapd-")});
+  }
+  try {
+    if (map_rovers.size() != runs.size()) throw std::runtime_error("a rover has no flight log");
+    const TeamMapResult map = EvaluateTeamMap(map_rovers, report);
+    r.team_map_precision = map.quality.map_precision;
+    r.team_map_recall = map.quality.map_recall;
+    r.team_submaps_placed = map.submaps_placed;
+    r.team_submaps = map.submaps;
+  } catch (const std::exception& e) {
+    report << "  team map: " << e.what() << "\n";
+  }
   r.team_line = "RESULT team scenario=" + scenario + " rovers=" + std::to_string(runs.size()) +
                 " inter_robot_closures=" + std::to_string(r.inter_robot_closures) +
                 " inter_robot_matches=" + std::to_string(r.inter_robot_matches) +
                 " robot_detections=" + std::to_string(r.robot_detections) +
                 " shared_landmark_sightings=" + std::to_string(r.shared_landmark_sightings) +
                 " slam_final_err_pct_max=" + Fixed(r.slam_final_err_pct_max, 4) +
-                " link_bytes_per_s_max=" + Fixed(r.link_bytes_per_s_max, 0);
+                " link_bytes_per_s_max=" + Fixed(r.link_bytes_per_s_max, 0) +
+                " team_map_precision=" + Fixed(r.team_map_precision, 4) +
+                " team_map_recall=" + Fixed(r.team_map_recall, 4) +
+                " team_submaps_placed=" + std::to_string(r.team_submaps_placed) + "/" +
+                std::to_string(r.team_submaps);
   return r;
 }
 

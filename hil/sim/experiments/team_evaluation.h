@@ -38,6 +38,12 @@ struct TeamResult {
   /// Over the rovers: the worst final SLAM error and link rate.
   double slam_final_err_pct_max = std::numeric_limits<double>::quiet_NaN();
   double link_bytes_per_s_max = std::numeric_limits<double>::quiet_NaN();
+  /// The team's map (every rover's submaps at the team graph's origins)
+  /// against the world.
+  double team_map_precision = std::numeric_limits<double>::quiet_NaN();
+  double team_map_recall = std::numeric_limits<double>::quiet_NaN();
+  uint64_t team_submaps_placed = 0;
+  uint64_t team_submaps = 0;
 };
 
 /// The value of `key=` in a RESULT line ("" if absent).

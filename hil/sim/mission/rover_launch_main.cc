@@ -17,6 +17,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <string>
 #include <thread>
@@ -29,6 +30,7 @@
 #include "firmware/runtime/process/child_process.h"
 #include "hil/sim/experiments/map_command.h"
 #include "hil/sim/scenario/scenario.h"
+#include "hil/sim/scenario/team_rovers.h"
 #include "hil/sim/world/world.h"
 
 namespace {
@@ -144,7 +146,13 @@ std::string WriteTagMarkers(const std::vector<std::string>& roverd_args, const f
   const sim::World world = sim::World::Generate(scenario.world, seed);
   const fs::path path = run_dir / "tags.yaml";
   std::ofstream out(path);
-  out << sim::TagMarkerFile(world);
+  // Robot markers in each rover's body frame, as its filter knows it.
+  const sim::TeamRovers team = sim::MakeTeamRovers(scenario, world);
+  std::map<int, double> body_height_m;
+  for (std::size_t k = 0; k < team.size(); ++k) {
+    body_height_m[static_cast<int>(k)] = team.trajectories[k].options().body_height_m;
+  }
+  out << sim::TagMarkerFile(world, body_height_m);
   if (!out) throw std::runtime_error("cannot write " + path.string());
   std::size_t tags = 0;
   for (const sim::TagCarrier& c : world.carriers) tags += c.tags.size();

@@ -101,6 +101,10 @@ int main(int argc, char** argv) {
   app.add_option("--budget-bytes-per-s", budget_bytes_per_s,
                  "what each rover may send on the link, on average")
       ->capture_default_str();
+  bool evaluate_only = false;
+  app.add_flag("--evaluate-only", evaluate_only,
+               "run nothing: score the team mission already in --out (after a change to the "
+               "evaluation, or to look again)");
   app.add_option("roverd_args", roverd_args,
                  "arguments for every rover's roverd-sim (after --): --sim, --seed, ...");
   CLI11_PARSE(app, argc, argv);
@@ -122,72 +126,79 @@ int main(int argc, char** argv) {
     const sim::TeamRovers team = sim::MakeTeamRovers(scenario, world);
     n = team.size();
     if (n < 2) throw std::invalid_argument("scenario " + scenario_name + " has one rover");
-    fs::create_directories(out);
-    const fs::path team_file = fs::absolute(fs::path(out) / "team.yaml");
-    std::ofstream(team_file) << TeamFile(team.names, domain_id, budget_bytes_per_s);
-    // Leftovers of an earlier run that was killed.
-    ChildProcess::Spawn({.argv = {netns.string(), "down", std::to_string(n)},
-                         .output_file = (fs::path(out) / "netns.txt").string()})
-        .WaitFor(Duration::Seconds(30));
-    Run({netns.string(), "up", std::to_string(n)}, fs::path(out) / "netns.txt");
-    Say("team link up: " + std::to_string(n) + " rovers in namespaces rover1..rover" +
-        std::to_string(n) + " (10.77.0.1..), team file " + team_file.string());
-
-    std::vector<ChildProcess> rovers;
     std::vector<fs::path> outputs;
-    for (std::size_t k = 0; k < n; ++k) {
-      const fs::path dir = fs::absolute(fs::path(out) / team.names[k]);
-      fs::create_directories(dir);
-      outputs.push_back(dir / "launch.txt");
-      fs::remove(outputs.back());
-      std::vector<std::string> command = {
-          "ip", "netns", "exec", "rover" + std::to_string(k + 1), "unshare", "--mount",
-          "--propagation", "private", "--", "sh", "-c",
-          // A board of its own: its RouDi's shared memory and socket stay in here.
-          "mount -t tmpfs rover-shm /dev/shm && mount -t tmpfs rover-tmp /tmp && exec \"$@\"", "sh",
-          fs::absolute(fs::path(bin) / "hil/sim/mission/rover-launch").string(), "--roverd-sim",
-          fs::absolute(fs::path(bin) / "hil/sim/mission/roverd-sim").string(), "--mapd",
-          fs::absolute(fs::path(bin) / "firmware/mapd/mapd").string(), "--roudi-config",
-          fs::absolute(fs::path(source) / "firmware/config/roudi.toml").string(), "--config",
-          fs::absolute(fs::path(source) / "firmware/config/sim.yaml").string(), "--mapd-arg=--team",
-          "--mapd-arg=" + team_file.string(), "--mapd-arg=--robot-id",
-          "--mapd-arg=" + std::to_string(k),
-          // Not a repeatable option right before "--": CLI11 then takes
-          // what follows as unexpected arguments.
-          "--evaluate-map", dir.string(), "--run-dir", (dir / "run").string(), "--"};
-      command.insert(command.end(), roverd_args.begin(), roverd_args.end());
-      command.insert(command.end(), {"--rover", std::to_string(k), "--out", dir.string()});
-      rovers.push_back(
-          ChildProcess::Spawn({.argv = command, .output_file = outputs.back().string()}));
-      Say(team.names[k] + " started (pid " + std::to_string(rovers.back().pid()) + "), output " +
-          outputs.back().string());
-    }
-    const Time start = Time::Now();
-    Time next_status = start + Duration::Seconds(15);
     std::vector<std::optional<rover::runtime::ExitStatus>> status(n);
-    std::size_t running = n;
-    while (running > 0) {
+    if (evaluate_only) {
       for (std::size_t k = 0; k < n; ++k) {
-        if (status[k] || !(status[k] = rovers[k].TryWait())) continue;
-        --running;
-        Say(team.names[k] + " done (" + status[k]->Describe() + ") after " +
-            std::to_string(static_cast<int>((Time::Now() - start).ToSeconds())) + " s");
+        outputs.push_back(fs::absolute(fs::path(out) / team.names[k]) / "launch.txt");
+        status[k] = rover::runtime::ExitStatus{.exited = true, .exit_code = 0};
       }
-      if (g_stop != 0) {
-        Say("stopping on signal");
+    } else {
+      fs::create_directories(out);
+      const fs::path team_file = fs::absolute(fs::path(out) / "team.yaml");
+      std::ofstream(team_file) << TeamFile(team.names, domain_id, budget_bytes_per_s);
+      // Leftovers of an earlier run that was killed.
+      ChildProcess::Spawn({.argv = {netns.string(), "down", std::to_string(n)},
+                           .output_file = (fs::path(out) / "netns.txt").string()})
+          .WaitFor(Duration::Seconds(30));
+      Run({netns.string(), "up", std::to_string(n)}, fs::path(out) / "netns.txt");
+      Say("team link up: " + std::to_string(n) + " rovers in namespaces rover1..rover" +
+          std::to_string(n) + " (10.77.0.1..), team file " + team_file.string());
+
+      std::vector<ChildProcess> rovers;
+      for (std::size_t k = 0; k < n; ++k) {
+        const fs::path dir = fs::absolute(fs::path(out) / team.names[k]);
+        fs::create_directories(dir);
+        outputs.push_back(dir / "launch.txt");
+        fs::remove(outputs.back());
+        std::vector<std::string> command = {
+            "ip", "netns", "exec", "rover" + std::to_string(k + 1), "unshare", "--mount",
+            "--propagation", "private", "--", "sh", "-c",
+            // A board of its own: its RouDi's shared memory and socket stay in here.
+            "mount -t tmpfs rover-shm /dev/shm && mount -t tmpfs rover-tmp /tmp && exec \"$@\"",
+            "sh", fs::absolute(fs::path(bin) / "hil/sim/mission/rover-launch").string(),
+            "--roverd-sim", fs::absolute(fs::path(bin) / "hil/sim/mission/roverd-sim").string(),
+            "--mapd", fs::absolute(fs::path(bin) / "firmware/mapd/mapd").string(), "--roudi-config",
+            fs::absolute(fs::path(source) / "firmware/config/roudi.toml").string(), "--config",
+            fs::absolute(fs::path(source) / "firmware/config/sim.yaml").string(),
+            "--mapd-arg=--team", "--mapd-arg=" + team_file.string(), "--mapd-arg=--robot-id",
+            "--mapd-arg=" + std::to_string(k),
+            // Not a repeatable option right before "--": CLI11 then takes
+            // what follows as unexpected arguments.
+            "--evaluate-map", dir.string(), "--run-dir", (dir / "run").string(), "--"};
+        command.insert(command.end(), roverd_args.begin(), roverd_args.end());
+        command.insert(command.end(), {"--rover", std::to_string(k), "--out", dir.string()});
+        rovers.push_back(
+            ChildProcess::Spawn({.argv = command, .output_file = outputs.back().string()}));
+        Say(team.names[k] + " started (pid " + std::to_string(rovers.back().pid()) + "), output " +
+            outputs.back().string());
+      }
+      const Time start = Time::Now();
+      Time next_status = start + Duration::Seconds(15);
+      std::size_t running = n;
+      while (running > 0) {
         for (std::size_t k = 0; k < n; ++k) {
-          if (!status[k]) status[k] = rovers[k].Terminate(Duration::Seconds(90));
+          if (status[k] || !(status[k] = rovers[k].TryWait())) continue;
+          --running;
+          Say(team.names[k] + " done (" + status[k]->Describe() + ") after " +
+              std::to_string(static_cast<int>((Time::Now() - start).ToSeconds())) + " s");
         }
-        break;
+        if (g_stop != 0) {
+          Say("stopping on signal");
+          for (std::size_t k = 0; k < n; ++k) {
+            if (!status[k]) status[k] = rovers[k].Terminate(Duration::Seconds(90));
+          }
+          break;
+        }
+        if (next_status < Time::Now()) {
+          next_status = Time::Now() + Duration::Seconds(15);
+          Say(std::to_string(running) + " of " + std::to_string(n) + " rovers still running, " +
+              std::to_string(static_cast<int>((Time::Now() - start).ToSeconds())) + " s");
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
       }
-      if (next_status < Time::Now()) {
-        next_status = Time::Now() + Duration::Seconds(15);
-        Say(std::to_string(running) + " of " + std::to_string(n) + " rovers still running, " +
-            std::to_string(static_cast<int>((Time::Now() - start).ToSeconds())) + " s");
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      Run({netns.string(), "down", std::to_string(n)}, fs::path(out) / "netns.txt");
     }
-    Run({netns.string(), "down", std::to_string(n)}, fs::path(out) / "netns.txt");
 
     std::vector<sim::experiments::TeamRoverRun> runs;
     bool ok = true;

@@ -240,7 +240,7 @@ void ExportWorldGroundTruth(const World& world, const std::string& dir,
   }
 }
 
-std::string TagMarkerFile(const World& world) {
+std::string TagMarkerFile(const World& world, const std::map<int, double>& rover_body_height_m) {
   std::ostringstream out;
   out << "# The simulated world's AprilTags (seed " << world.seed
       << "): landmark posts and other rovers.\n"
@@ -259,8 +259,16 @@ std::string TagMarkerFile(const World& world) {
       } else {
         out << "robot: " << robot;
       }
+      Eigen::Isometry3d T_marker_tag = tag.T_carrier_tag;
+      if (!carrier.is_static) {
+        // Into the body frame: the carrier frame is body_height below it.
+        const auto height = rover_body_height_m.find(robot);
+        if (height != rover_body_height_m.end()) {
+          T_marker_tag.translation().z() -= height->second;
+        }
+      }
       out << ", T_carrier_tag: [";
-      const Eigen::Matrix4d T = tag.T_carrier_tag.matrix();
+      const Eigen::Matrix4d T = T_marker_tag.matrix();
       for (int i = 0; i < 16; ++i) out << (i > 0 ? ", " : "") << Num(T(i / 4, i % 4));
       out << "]}  # " << carrier.name << "\n";
     }

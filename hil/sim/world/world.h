@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -309,8 +310,13 @@ void ExportWorldGroundTruth(const World& world, const std::string& dir,
 /// tags, as a site survey would give it: family tag36h11; every tag of
 /// landmark post k is a marker of landmark k with its T_carrier_tag (so the
 /// four faces are one landmark); the tags of moving carriers are robot
-/// markers (robot 1, 2, ... in carrier order).
-std::string TagMarkerFile(const World& world);
+/// markers, numbered as the team numbers its rovers ("rover_a" 0, the other
+/// rovers 1, 2, ... in world order). A robot marker's pose is in that rover's
+/// body (IMU) frame, which its filter estimates: a moving carrier's frame
+/// sits `rover_body_height_m[robot]` below it (RoverTrajectoryOptions::
+/// body_height_m; a robot not in the map: 0, the carrier frame).
+std::string TagMarkerFile(const World& world,
+                          const std::map<int, double>& rover_body_height_m = {});
 
 }  // namespace rover::sim
 

@@ -536,5 +536,29 @@ TEST(WorldTest, TheTagMarkerFileNamesEveryTagWithItsCarrier) {
   EXPECT_EQ(options.markers.back().carrier, mapping::TagMarker::Carrier::kRobot);
 }
 
+// A robot marker is where the other rover's filter puts its body: the
+// carrier frame (ground level) moved up by the rover's body height.
+TEST(WorldTest, RobotMarkersAreInTheRoversBodyFrame) {
+  const World& world = SmallWorld();
+  const mapping::TagObserverOptions in_body = mapping::TagObserverOptions::Load(
+      ConfigNode::LoadString(TagMarkerFile(world, {{1, 0.35}}), "tags.yaml"));
+  const mapping::TagObserverOptions in_carrier =
+      mapping::TagObserverOptions::Load(ConfigNode::LoadString(TagMarkerFile(world), "tags.yaml"));
+  ASSERT_EQ(in_body.markers.size(), in_carrier.markers.size());
+  int robot_markers = 0;
+  for (std::size_t k = 0; k < in_body.markers.size(); ++k) {
+    const mapping::TagMarker& b = in_body.markers[k];
+    const mapping::TagMarker& c = in_carrier.markers[k];
+    const double dz = b.T_carrier_tag.translation().z() - c.T_carrier_tag.translation().z();
+    if (b.carrier == mapping::TagMarker::Carrier::kRobot && b.robot == 1) {
+      EXPECT_NEAR(dz, -0.35, 1e-12);
+      ++robot_markers;
+    } else {
+      EXPECT_EQ(dz, 0.0);
+    }
+  }
+  EXPECT_GT(robot_markers, 0);
+}
+
 }  // namespace
 }  // namespace rover::sim
