@@ -2,9 +2,11 @@
 
 #include <zstd.h>
 
+#include <cmath>
 #include <string>
 
 #include "core/log/msgs/message_traits.h"
+#include "mapping/submap/submap_messages.h"
 #include "mapping/team/message_head.h"
 
 namespace rover::mapping {
@@ -33,6 +35,64 @@ void ReadMessage(link::wire::Reader* r, const char* what, M* msg) {
   }
 }
 
+// The cloud travels quantised to 1 mm (its points are centroids of 5 cm
+// voxels), each axis delta-coded between successive points and split into
+// byte planes: zstd then finds the long runs that float bytes never have.
+constexpr double kCloudQuantumM = 0.001;
+
+uint32_t ZigZag(int32_t v) {
+  return (static_cast<uint32_t>(v) << 1) ^ static_cast<uint32_t>(v >> 31);
+}
+int32_t UnZigZag(uint32_t v) { return static_cast<int32_t>(v >> 1) ^ -static_cast<int32_t>(v & 1); }
+
+void AppendCloud(const log::sensor_msgs::PointCloud2& msg, link::wire::Writer* w) {
+  const PointCloud cloud = FromPointCloud2(msg);
+  const std::size_t n = cloud.size();
+  w->U32(static_cast<uint32_t>(n));
+  std::vector<uint8_t> planes(13 * n);
+  for (int axis = 0; axis < 3; ++axis) {
+    int32_t previous = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int32_t q = static_cast<int32_t>(
+          std::lround(static_cast<double>(cloud[i].p_submap_m[axis]) / kCloudQuantumM));
+      const uint32_t z = ZigZag(q - previous);
+      previous = q;
+      for (int b = 0; b < 4; ++b) {
+        planes[(static_cast<std::size_t>(axis) * 4 + static_cast<std::size_t>(b)) * n + i] =
+            static_cast<uint8_t>(z >> (8 * b));
+      }
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) planes[12 * n + i] = cloud[i].obstacle ? 1 : 0;
+  w->Bytes(planes);
+}
+
+log::sensor_msgs::PointCloud2 ReadCloud(link::wire::Reader* r,
+                                        const log::std_msgs::Header& header) {
+  const uint32_t n = r->U32();
+  if (r->failed() || static_cast<std::size_t>(n) * 13 > r->remaining()) {
+    throw TeamMessageError("team submap: cloud truncated");
+  }
+  const std::span<const uint8_t> planes = r->Bytes(static_cast<std::size_t>(n) * 13);
+  PointCloud cloud(n);
+  for (int axis = 0; axis < 3; ++axis) {
+    int32_t value = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      uint32_t z = 0;
+      for (int b = 0; b < 4; ++b) {
+        z |= static_cast<uint32_t>(
+                 planes[(static_cast<std::size_t>(axis) * 4 + static_cast<std::size_t>(b)) * n + i])
+             << (8 * b);
+      }
+      value += UnZigZag(z);
+      cloud[i].p_submap_m[axis] = static_cast<float>(value * kCloudQuantumM);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    cloud[i].obstacle = planes[12 * static_cast<std::size_t>(n) + i] != 0;
+  return ToPointCloud2(cloud, header);
+}
+
 }  // namespace
 
 std::vector<uint8_t> EncodeSubmap(const TeamSubmap& submap, int level) {
@@ -40,7 +100,7 @@ std::vector<uint8_t> EncodeSubmap(const TeamSubmap& submap, int level) {
   link::wire::Writer body(&raw);
   AppendMessage(submap.info, &body);
   AppendMessage(submap.octomap, &body);
-  AppendMessage(submap.cloud, &body);
+  AppendCloud(submap.cloud, &body);
   std::vector<uint8_t> out;
   link::wire::Writer w(&out);
   WriteHead(&w, Kind::kSubmap);
@@ -86,7 +146,7 @@ TeamSubmap DecodeSubmap(std::span<const uint8_t> bytes) {
   link::wire::Reader body(raw);
   ReadMessage(&body, "SubmapInfo", &out.info);
   ReadMessage(&body, "Octomap", &out.octomap);
-  ReadMessage(&body, "PointCloud2", &out.cloud);
+  out.cloud = ReadCloud(&body, out.info.header);
   CheckEnd(body, Kind::kSubmap);
   return out;
 }

@@ -3,10 +3,13 @@
 
 // A finished submap as it travels to the other rovers: the three messages
 // mapd logs for it (rover_msgs/SubmapInfo, octomap_msgs/Octomap and
-// sensor_msgs/PointCloud2, ROS 2 CDR), compressed together with zstd, sent
-// once. The receiver gets what the sender logged, so it can match the
-// submap against its own, compose the team's map, and log it in the same
-// form.
+// sensor_msgs/PointCloud2), compressed together with zstd, sent once. The
+// info and octree travel as their CDR; the cloud, which is most of a
+// submap, as its points quantised to 1 mm (they are centroids of 5 cm
+// voxels), delta-coded and split into byte planes, which zstd compresses to
+// a fraction of the float bytes. The receiver gets what the sender logged,
+// the cloud to the millimetre, so it can match the submap against its own,
+// compose the team's map, and log it in the same form.
 
 #include <cstdint>
 #include <span>
@@ -21,6 +24,7 @@ namespace rover::mapping {
 struct TeamSubmap {
   log::rover_msgs::SubmapInfo info;
   log::octomap_msgs::Octomap octomap;
+  /// mapd's cloud layout (mapping::ToPointCloud2, the header of `info`).
   log::sensor_msgs::PointCloud2 cloud;
 };
 

@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
 #include <string>
 
+#include "core/log/msgs/message_traits.h"
+#include "mapping/submap/submap_messages.h"
 #include "mapping/team/team_message.h"
 
 namespace rover::mapping {
@@ -26,15 +30,21 @@ TeamSubmap SomeSubmap() {
   for (std::size_t k = 0; k < s.octomap.data.size(); ++k) {
     s.octomap.data[k] = static_cast<int8_t>((k % 7 == 0) ? 0x55 : 0);
   }
-  s.cloud.header = s.info.header;
-  s.cloud.height = 1;
-  s.cloud.width = 100;
-  s.cloud.point_step = 12;
-  s.cloud.row_step = 1200;
-  s.cloud.data.resize(1200);
-  for (std::size_t k = 0; k < s.cloud.data.size(); ++k) {
-    s.cloud.data[k] = static_cast<uint8_t>(k * 37);
+  // A cloud as mapd builds it: centroids of 5 cm voxels over some ground.
+  PointCloud cloud;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> jitter(-0.02f, 0.02f);
+  for (int x = -100; x < 100; ++x) {
+    for (int y = -60; y < 60; y += 2) {
+      CloudPoint p;
+      p.p_submap_m = Eigen::Vector3f(0.05f * static_cast<float>(x) + jitter(rng),
+                                     0.05f * static_cast<float>(y) + jitter(rng),
+                                     -0.35f + 0.1f * std::sin(0.1f * static_cast<float>(x)));
+      p.obstacle = (x * y) % 17 == 0;
+      cloud.push_back(p);
+    }
   }
+  s.cloud = ToPointCloud2(cloud, s.info.header);
   return s;
 }
 
@@ -48,14 +58,26 @@ void ExpectRefused(F f, const std::string& needle) {
   }
 }
 
-TEST(TeamSubmapTest, ASubmapArrivesAsTheSenderLoggedItAndSmaller) {
+TEST(TeamSubmapTest, ASubmapArrivesAsTheSenderLoggedItToTheMillimetreAndSmaller) {
   const TeamSubmap sent = SomeSubmap();
   const std::vector<uint8_t> bytes = EncodeSubmap(sent);
-  EXPECT_LT(bytes.size(), 61200u / 4) << "compressed";
+  const std::size_t raw = log::SerializedSize(sent.info) + log::SerializedSize(sent.octomap) +
+                          log::SerializedSize(sent.cloud);
+  EXPECT_LT(bytes.size(), raw / 3) << "compressed " << bytes.size() << " of " << raw;
   const TeamSubmap got = DecodeSubmap(bytes);
   EXPECT_EQ(got.info, sent.info);
   EXPECT_EQ(got.octomap, sent.octomap);
-  EXPECT_EQ(got.cloud, sent.cloud);
+  EXPECT_EQ(got.cloud.fields, sent.cloud.fields);
+  EXPECT_EQ(got.cloud.header, sent.cloud.header);
+  const PointCloud a = FromPointCloud2(sent.cloud);
+  const PointCloud b = FromPointCloud2(got.cloud);
+  ASSERT_EQ(a.size(), b.size());
+  float worst = 0.0f;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    worst = std::max(worst, (a[k].p_submap_m - b[k].p_submap_m).cwiseAbs().maxCoeff());
+    ASSERT_EQ(a[k].obstacle, b[k].obstacle) << k;
+  }
+  EXPECT_LE(worst, 0.0005f + 1e-6f);
 }
 
 TEST(TeamSubmapTest, DamageTruncationAndHostileSizesAreRefusedByName) {
