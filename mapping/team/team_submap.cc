@@ -3,6 +3,7 @@
 #include <zstd.h>
 
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "core/log/msgs/message_traits.h"
@@ -17,11 +18,19 @@ using team_internal::Kind;
 using team_internal::ReadHead;
 using team_internal::WriteHead;
 
+// Copies are made in place: a vector insert after push_backs trips a false
+// stringop-overflow warning in GCC 12 at -O3.
+void AppendBytes(std::span<const std::byte> bytes, std::vector<uint8_t>* raw) {
+  const std::size_t base = raw->size();
+  raw->resize(base + bytes.size());
+  if (!bytes.empty()) std::memcpy(raw->data() + base, bytes.data(), bytes.size());
+}
+
 template <typename M>
-void AppendMessage(const M& msg, link::wire::Writer* w) {
+void AppendMessage(const M& msg, std::vector<uint8_t>* raw) {
   const std::vector<std::byte> cdr = log::SerializeMessage(msg);
-  w->U32(static_cast<uint32_t>(cdr.size()));
-  w->Bytes(std::span(reinterpret_cast<const uint8_t*>(cdr.data()), cdr.size()));
+  link::wire::Writer(raw).U32(static_cast<uint32_t>(cdr.size()));
+  AppendBytes(cdr, raw);
 }
 
 template <typename M>
@@ -45,11 +54,13 @@ uint32_t ZigZag(int32_t v) {
 }
 int32_t UnZigZag(uint32_t v) { return static_cast<int32_t>(v >> 1) ^ -static_cast<int32_t>(v & 1); }
 
-void AppendCloud(const log::sensor_msgs::PointCloud2& msg, link::wire::Writer* w) {
+void AppendCloud(const log::sensor_msgs::PointCloud2& msg, std::vector<uint8_t>* raw) {
   const PointCloud cloud = FromPointCloud2(msg);
   const std::size_t n = cloud.size();
-  w->U32(static_cast<uint32_t>(n));
-  std::vector<uint8_t> planes(13 * n);
+  link::wire::Writer(raw).U32(static_cast<uint32_t>(n));
+  const std::size_t base = raw->size();
+  raw->resize(base + 13 * n);
+  uint8_t* planes = raw->data() + base;
   for (int axis = 0; axis < 3; ++axis) {
     int32_t previous = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -64,7 +75,6 @@ void AppendCloud(const log::sensor_msgs::PointCloud2& msg, link::wire::Writer* w
     }
   }
   for (std::size_t i = 0; i < n; ++i) planes[12 * n + i] = cloud[i].obstacle ? 1 : 0;
-  w->Bytes(planes);
 }
 
 log::sensor_msgs::PointCloud2 ReadCloud(link::wire::Reader* r,
@@ -97,10 +107,9 @@ log::sensor_msgs::PointCloud2 ReadCloud(link::wire::Reader* r,
 
 std::vector<uint8_t> EncodeSubmap(const TeamSubmap& submap, int level) {
   std::vector<uint8_t> raw;
-  link::wire::Writer body(&raw);
-  AppendMessage(submap.info, &body);
-  AppendMessage(submap.octomap, &body);
-  AppendCloud(submap.cloud, &body);
+  AppendMessage(submap.info, &raw);
+  AppendMessage(submap.octomap, &raw);
+  AppendCloud(submap.cloud, &raw);
   std::vector<uint8_t> out;
   link::wire::Writer w(&out);
   WriteHead(&w, Kind::kSubmap);
