@@ -18,19 +18,18 @@ using team_internal::Kind;
 using team_internal::ReadHead;
 using team_internal::WriteHead;
 
-// Copies are made in place: a vector insert after push_backs trips a false
-// stringop-overflow warning in GCC 12 at -O3.
-void AppendBytes(std::span<const std::byte> bytes, std::vector<uint8_t>* raw) {
-  const std::size_t base = raw->size();
-  raw->resize(base + bytes.size());
-  if (!bytes.empty()) std::memcpy(raw->data() + base, bytes.data(), bytes.size());
+// Writes `v` little-endian at `at` (and moves `at` on).
+void PutU32(uint32_t v, std::vector<uint8_t>* out, std::size_t* at) {
+  for (int b = 0; b < 4; ++b) (*out)[(*at)++] = static_cast<uint8_t>(v >> (8 * b));
 }
 
-template <typename M>
-void AppendMessage(const M& msg, std::vector<uint8_t>* raw) {
-  const std::vector<std::byte> cdr = log::SerializeMessage(msg);
-  link::wire::Writer(raw).U32(static_cast<uint32_t>(cdr.size()));
-  AppendBytes(cdr, raw);
+// Appends a length-prefixed CDR message. The buffer is sized first and
+// written by index: a vector insert after push_backs trips a false
+// stringop-overflow warning in GCC 12 at -O3.
+void PutMessage(std::span<const std::byte> cdr, std::vector<uint8_t>* out, std::size_t* at) {
+  PutU32(static_cast<uint32_t>(cdr.size()), out, at);
+  if (!cdr.empty()) std::memcpy(out->data() + *at, cdr.data(), cdr.size());
+  *at += cdr.size();
 }
 
 template <typename M>
@@ -54,13 +53,14 @@ uint32_t ZigZag(int32_t v) {
 }
 int32_t UnZigZag(uint32_t v) { return static_cast<int32_t>(v >> 1) ^ -static_cast<int32_t>(v & 1); }
 
-void AppendCloud(const log::sensor_msgs::PointCloud2& msg, std::vector<uint8_t>* raw) {
+// The point count, then the planes (see kCloudQuantumM).
+std::vector<uint8_t> CloudPlanes(const log::sensor_msgs::PointCloud2& msg) {
   const PointCloud cloud = FromPointCloud2(msg);
   const std::size_t n = cloud.size();
-  link::wire::Writer(raw).U32(static_cast<uint32_t>(n));
-  const std::size_t base = raw->size();
-  raw->resize(base + 13 * n);
-  uint8_t* planes = raw->data() + base;
+  std::vector<uint8_t> out(4 + 13 * n);
+  std::size_t at = 0;
+  PutU32(static_cast<uint32_t>(n), &out, &at);
+  uint8_t* planes = out.data() + at;
   for (int axis = 0; axis < 3; ++axis) {
     int32_t previous = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -75,6 +75,7 @@ void AppendCloud(const log::sensor_msgs::PointCloud2& msg, std::vector<uint8_t>*
     }
   }
   for (std::size_t i = 0; i < n; ++i) planes[12 * n + i] = cloud[i].obstacle ? 1 : 0;
+  return out;
 }
 
 log::sensor_msgs::PointCloud2 ReadCloud(link::wire::Reader* r,
@@ -106,10 +107,14 @@ log::sensor_msgs::PointCloud2 ReadCloud(link::wire::Reader* r,
 }  // namespace
 
 std::vector<uint8_t> EncodeSubmap(const TeamSubmap& submap, int level) {
-  std::vector<uint8_t> raw;
-  AppendMessage(submap.info, &raw);
-  AppendMessage(submap.octomap, &raw);
-  AppendCloud(submap.cloud, &raw);
+  const std::vector<std::byte> info = log::SerializeMessage(submap.info);
+  const std::vector<std::byte> octomap = log::SerializeMessage(submap.octomap);
+  const std::vector<uint8_t> cloud = CloudPlanes(submap.cloud);
+  std::vector<uint8_t> raw(8 + info.size() + octomap.size() + cloud.size());
+  std::size_t at = 0;
+  PutMessage(info, &raw, &at);
+  PutMessage(octomap, &raw, &at);
+  std::memcpy(raw.data() + at, cloud.data(), cloud.size());
   std::vector<uint8_t> out;
   link::wire::Writer w(&out);
   WriteHead(&w, Kind::kSubmap);
