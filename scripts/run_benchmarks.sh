@@ -20,6 +20,9 @@ echo
 echo "== Pose graph (bench_graph; add --outliers for the false-loop-closure study)"
 "$build/bench/graph/bench_graph"
 echo
+echo "== Team graph: Helmert blocking (one block per robot) against the full solve; online update"
+"$build/bench/graph/bench_team_graph"
+echo
 echo "== Stereo matching on EuRoC (bench_stereo_matcher)"
 "$build/bench/vo/bench_stereo_matcher"
 echo
