@@ -66,6 +66,27 @@ std::string TeamFile(const std::vector<std::string>& names, uint32_t domain_id,
   return s;
 }
 
+// Run by `sh -c` in a rover's private mount namespace: a board of its own,
+// whose RouDi's shared memory (/dev/shm) and sockets (/tmp) stay in here. The
+// host's /tmp is hidden then, so the folders given before `--` (output,
+// build, source) that lie under it are bound back in at the same paths.
+// Arguments: the rover's number, the folders, --, the command.
+constexpr const char* kPrivateBoard = R"(set -e
+n=$1; shift
+host=/run/rover-team/tmp-$n
+mkdir -p "$host"
+mount --bind /tmp "$host"
+mount -t tmpfs rover-shm /dev/shm
+mount -t tmpfs rover-tmp /tmp
+while [ "$1" != "--" ]; do
+  case "$1" in
+    /tmp/*) mkdir -p "$1"; mount --bind "$host/${1#/tmp/}" "$1" ;;
+  esac
+  shift
+done
+shift
+exec "$@")";
+
 // The last RESULT line of a rover's output ("" if none).
 std::string LastResultLine(const fs::path& path) {
   std::ifstream in(path);
@@ -153,12 +174,12 @@ int main(int argc, char** argv) {
         fs::remove(outputs.back());
         std::vector<std::string> command = {
             "ip", "netns", "exec", "rover" + std::to_string(k + 1), "unshare", "--mount",
-            "--propagation", "private", "--", "sh", "-c",
-            // A board of its own: its RouDi's shared memory and socket stay in here.
-            "mount -t tmpfs rover-shm /dev/shm && mount -t tmpfs rover-tmp /tmp && exec \"$@\"",
-            "sh", fs::absolute(fs::path(bin) / "hil/sim/mission/rover-launch").string(),
-            "--roverd-sim", fs::absolute(fs::path(bin) / "hil/sim/mission/roverd-sim").string(),
-            "--mapd", fs::absolute(fs::path(bin) / "firmware/mapd/mapd").string(), "--roudi-config",
+            "--propagation", "private", "--", "sh", "-c", kPrivateBoard, "sh",
+            std::to_string(k + 1), fs::absolute(out).string(), fs::absolute(bin).string(),
+            fs::absolute(source).string(), "--",
+            fs::absolute(fs::path(bin) / "hil/sim/mission/rover-launch").string(), "--roverd-sim",
+            fs::absolute(fs::path(bin) / "hil/sim/mission/roverd-sim").string(), "--mapd",
+            fs::absolute(fs::path(bin) / "firmware/mapd/mapd").string(), "--roudi-config",
             fs::absolute(fs::path(source) / "firmware/config/roudi.toml").string(), "--config",
             fs::absolute(fs::path(source) / "firmware/config/sim.yaml").string(),
             "--mapd-arg=--team", "--mapd-arg=" + team_file.string(), "--mapd-arg=--robot-id",
