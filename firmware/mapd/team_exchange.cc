@@ -109,7 +109,15 @@ std::string TeamExchange::Check(const mapping::GraphFactorRecord& record) const 
 }
 
 void TeamExchange::ShareSubmap(const mapping::TeamSubmap& submap, int64_t stamp_ns) {
-  std::vector<uint8_t> bytes = mapping::EncodeSubmap(submap);
+  std::vector<uint8_t> bytes;
+  try {
+    bytes = mapping::EncodeSubmap(submap);
+  } catch (const std::exception& e) {
+    // The team goes without this submap; mapping goes on.
+    ++stats_.submaps_not_shared;
+    std::fprintf(stderr, "mapd: team: submap %u not shared: %s\n", submap.info.frame_id, e.what());
+    return;
+  }
   const uint64_t seq = ++sent_[mapping::TeamStream::kSubmaps];
   Log(mapping::kTeamSentTopic, self_, mapping::TeamStream::kSubmaps, seq, bytes, stamp_ns);
   ++stats_.submaps_shared;

@@ -52,6 +52,7 @@ struct TeamExchangeStats {
   uint64_t messages_resumed = 0;      ///< taken over from the previous mapd's log
   uint64_t submaps_shared = 0;
   uint64_t submap_bytes_shared = 0;  ///< compressed, as sent
+  uint64_t submaps_not_shared = 0;   ///< could not be encoded (message printed)
   uint64_t submaps_received = 0;
   uint64_t submaps_refused = 0;  ///< did not decode (damage, checksum); see last_refusal
   uint64_t claims_shared = 0;

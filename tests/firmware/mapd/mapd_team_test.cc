@@ -15,6 +15,7 @@
 #include "core/link/dds/dds_link.h"
 #include "firmware/mapd/mapd.h"
 #include "mapping/slam/graph_log.h"
+#include "mapping/submap/submap_messages.h"
 
 namespace rover::mapd {
 namespace {
@@ -223,8 +224,11 @@ mapping::TeamSubmap SmallSubmap(uint32_t frame) {
   s.octomap.id = "OcTree";
   s.octomap.resolution = 0.1;
   s.octomap.data.assign(5000, 0);
-  s.cloud.height = 1;
-  s.cloud.data.assign(3000, 7);
+  mapping::PointCloud cloud(250);
+  for (std::size_t k = 0; k < cloud.size(); ++k) {
+    cloud[k].p_submap_m = Eigen::Vector3f(0.05f * static_cast<float>(k), 1.0f, -0.35f);
+  }
+  s.cloud = mapping::ToPointCloud2(cloud, s.info.header);
   return s;
 }
 
@@ -254,7 +258,15 @@ TEST(TeamExchangeTest, SubmapsAndClaimsArriveDecodedAndADamagedSubmapIsRefused) 
   EXPECT_EQ(got.submaps[0].robot, 0);
   EXPECT_EQ(got.submaps[0].messages.info.frame_id, 4u);
   EXPECT_EQ(got.submaps[0].messages.octomap.data.size(), 5000u);
+  EXPECT_EQ(got.submaps[0].messages.cloud.width, 250u);
   EXPECT_EQ(got.claims[0].b, mapping::GraphKey::Origin(1, 2));
+
+  // A submap whose cloud is not mapd's layout is not shared, and mapd goes on.
+  mapping::TeamSubmap odd = SmallSubmap(6);
+  odd.cloud.fields.clear();
+  a.ShareSubmap(odd, 0);
+  EXPECT_EQ(a.Stats().submaps_shared, 1u);
+  EXPECT_EQ(a.Stats().submaps_not_shared, 1u);
 
   std::vector<uint8_t> damaged = mapping::EncodeSubmap(SmallSubmap(5));
   damaged[damaged.size() - 6] ^= 0x40;

@@ -173,8 +173,9 @@ TEST(SchemaTest, RegistryListsEveryTypeOnce) {
   std::set<std::string_view> names;
   for (const MessageSchema& entry : AllMessageSchemas()) names.insert(entry.name);
   EXPECT_EQ(names.size(), AllMessageSchemas().size());
-  EXPECT_EQ(names.size(), 37u);
+  EXPECT_EQ(names.size(), 38u);
   EXPECT_TRUE(names.contains("rover_msgs/msg/LogHealth"));
+  EXPECT_TRUE(names.contains("rover_msgs/msg/TeamMessage"));
 }
 
 template <typename T>
