@@ -29,6 +29,7 @@
 #include "firmware/runtime/board/board_config.h"
 #include "firmware/runtime/process/child_process.h"
 #include "hil/sim/experiments/map_command.h"
+#include "hil/sim/experiments/team_evaluation.h"
 #include "hil/sim/scenario/scenario.h"
 #include "hil/sim/scenario/team_rovers.h"
 #include "hil/sim/world/world.h"
@@ -45,21 +46,13 @@ void OnSignal(int) { g_stop = 1; }
 
 void Say(const std::string& text) { std::fprintf(stderr, "rover-launch: %s\n", text.c_str()); }
 
-// The value of `key=` in a RESULT line ("" if absent).
-std::string ResultField(const std::string& line, const std::string& key) {
-  const std::size_t at = line.find(" " + key + "=");
-  if (at == std::string::npos) return "";
-  const std::size_t begin = at + key.size() + 2;
-  return line.substr(begin, line.find_first_of(" \n", begin) - begin);
-}
-
 // Scores the mission's map and prints the extended RESULT line. mapd's logs
 // are those its processes (`mapd_pids`) wrote into `map_dir`.
 void EvaluateMap(const std::string& roverd_result, const fs::path& map_dir,
                  const std::vector<int>& mapd_pids) {
   std::string line = roverd_result.substr(0, roverd_result.find('\n'));
   rover::sim::experiments::MapCommandOptions options;
-  options.mission_log = ResultField(line, "log");
+  options.mission_log = rover::sim::experiments::ResultLineField(line, "log");
   for (const auto& entry : fs::directory_iterator(map_dir)) {
     const std::string name = entry.path().filename().string();
     for (const int pid : mapd_pids) {
