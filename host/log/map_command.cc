@@ -164,12 +164,13 @@ int ComposeAndWrite(const MapOptions& options, const std::vector<mapping::Submap
 // The team's map: each log's submaps at its rover's origins in the team's
 // graph (SolveTeamGraph: the lowest robot's prior frames the map).
 int RunTeamMap(const MapOptions& options, const std::vector<mapping::SubmapLog>& logs,
-               const std::map<std::string, int>& robot_of_log, std::size_t total_submaps,
+               const mapping::GraphLogContents& graphs, std::size_t total_submaps,
                std::ostream& out, std::ostream& err) {
   const char* const kTool = "rover-log map: ";
+  const std::map<std::string, int>& robot_of_log = graphs.robot_of_log;
   mapping::TeamGraphSolution graph;
   try {
-    graph = mapping::SolveTeamGraph(options.mapd_logs);
+    graph = mapping::SolveTeamGraph(graphs);
   } catch (const std::exception& e) {
     err << kTool << "the team's graph: " << e.what() << "\n";
     return 2;
@@ -232,19 +233,14 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
     return 2;
   }
   // Several rovers' logs: the team's map, at the team graph's origins.
-  std::map<std::string, int> robot_of_log;
-  std::set<int> robots;
-  for (const std::string& path : options.mapd_logs) {
-    try {
-      const mapping::GraphLogContents g = mapping::ReadGraphLogs({path});
-      if (g.last_origins && !g.last_origins->origins.empty()) {
-        robot_of_log[path] = g.last_origins->origins.front().robot;
-        robots.insert(robot_of_log[path]);
-      }
-    } catch (const std::exception&) {
-      // Reported when the submaps are read below.
-    }
+  mapping::GraphLogContents graphs;
+  try {
+    graphs = mapping::ReadGraphLogs(options.mapd_logs);
+  } catch (const std::exception&) {
+    // An unreadable log is reported when the submaps are read below.
   }
+  std::set<int> robots;
+  for (const auto& [path, robot] : graphs.robot_of_log) robots.insert(robot);
   const bool team = robots.size() > 1;
   if (!team && options.roverd_log.empty() && options.mapd_logs.size() > 1) {
     err << kTool << options.mapd_logs.size()
@@ -294,7 +290,7 @@ int RunMap(const MapOptions& options, std::ostream& out, std::ostream& err) {
   }
 
   if (team) {
-    return RunTeamMap(options, logs, robot_of_log, total_submaps, out, err);
+    return RunTeamMap(options, logs, graphs, total_submaps, out, err);
   }
   // Where each frame lies in the map frame.
   std::map<uint32_t, Eigen::Isometry3d> origins;

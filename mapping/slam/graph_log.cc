@@ -48,7 +48,10 @@ void ReadOne(const std::string& path, std::set<std::pair<int, uint64_t>>* seen,
       }
     } else if (topic == kSubmapOriginsTopic) {
       log::rover_msgs::SubmapOrigins msg;
-      if (log::DeserializeMessage(m.data, &msg, &error)) out->last_origins = std::move(msg);
+      if (log::DeserializeMessage(m.data, &msg, &error)) {
+        if (!msg.origins.empty()) out->robot_of_log[path] = msg.origins.front().robot;
+        out->last_origins = std::move(msg);
+      }
     } else if (topic == kGlobalPoseTopic) {
       log::geometry_msgs::PoseWithCovarianceStamped msg;
       if (log::DeserializeMessage(m.data, &msg, &error)) out->last_global_pose = msg;

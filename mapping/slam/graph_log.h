@@ -43,6 +43,9 @@ struct GraphLogContents {
   /// once by origin, stream and number, in log order.
   std::vector<log::rover_msgs::TeamMessage> team_sent;
   std::vector<log::rover_msgs::TeamMessage> team_received;
+  /// The robot of each log's last origins (a mapd logs only its own), by
+  /// path; a log without origins is absent.
+  std::map<std::string, int> robot_of_log;
   uint64_t duplicates = 0;  ///< Factors read again (a later log repeats an earlier one's).
   bool truncated = false;   ///< Some file ends early (e.g. mapd was killed).
 };

@@ -6,19 +6,11 @@
 
 #include "mapping/graph/rover_graph.h"
 #include "mapping/slam/graph_factor_record.h"
-#include "mapping/slam/graph_log.h"
 
 namespace rover::mapping {
 
-TeamGraphSolution SolveTeamGraph(const std::vector<std::string>& mapd_logs) {
+TeamGraphSolution SolveTeamGraph(const GraphLogContents& all) {
   TeamGraphSolution out;
-  for (const std::string& path : mapd_logs) {
-    const GraphLogContents one = ReadGraphLogs({path});
-    if (one.last_origins && !one.last_origins->origins.empty()) {
-      out.robot_of_log[path] = one.last_origins->origins.front().robot;
-    }
-  }
-  const GraphLogContents all = ReadGraphLogs(mapd_logs);
   out.problems = all.problems;
   std::set<int> robots;
   for (const GraphFactorRecord& f : all.factors) {

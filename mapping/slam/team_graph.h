@@ -17,6 +17,8 @@
 
 #include <Eigen/Geometry>
 
+#include "mapping/slam/graph_log.h"
+
 namespace rover::mapping {
 
 struct TeamGraphSolution {
@@ -24,8 +26,6 @@ struct TeamGraphSolution {
   /// Every placed origin, T_anchor_origin by (robot, local frame id); the
   /// anchor's prior frame is the identity.
   std::map<std::pair<int, int64_t>, Eigen::Isometry3d> origins;
-  /// The robot each log is from (its logged origins' robot), by path.
-  std::map<std::string, int> robot_of_log;
   std::vector<int> robots;           ///< every robot with factors in the logs
   std::vector<int> unplaced_robots;  ///< of those, with no origin linked to the anchor
   uint64_t factors = 0;
@@ -33,9 +33,9 @@ struct TeamGraphSolution {
   std::vector<std::string> problems;  ///< from reading the logs
 };
 
-/// Reads `mapd_logs` (any rovers, any order) and solves the team's graph.
-/// Throws std::runtime_error if no log holds a prior.
-TeamGraphSolution SolveTeamGraph(const std::vector<std::string>& mapd_logs);
+/// Solves the team's graph from `logs`, read from mapd logs of any rovers
+/// (ReadGraphLogs). Throws std::runtime_error if no log holds a prior.
+TeamGraphSolution SolveTeamGraph(const GraphLogContents& logs);
 
 }  // namespace rover::mapping
 

@@ -124,6 +124,36 @@ Eigen::Isometry3d FourDof(const Eigen::Vector3d& p, const Eigen::Matrix3d& R) {
   return GravityAlignedTransform(p, YawOf(R));
 }
 
+// Frame 0 of `mission` in the world: the true body pose at initialisation
+// against the filter's estimate then (x, y, z, yaw).
+Eigen::Isometry3d TrueFrameZero(const MissionFacts& mission,
+                                const sim::RoverTrajectory& trajectory) {
+  const sim::TrajectorySample truth =
+      trajectory.Evaluate((mission.init_stamp - mission.start).ToSeconds());
+  return FourDof(truth.p_world_body, truth.q_world_body.toRotationMatrix()) *
+         FourDof(mission.T_local0_body_init.translation(), mission.T_local0_body_init.linear())
+             .inverse();
+}
+
+// The true pose of `T_body_cam` at time `t` of `mission`.
+Eigen::Isometry3d TrueCamera(const MissionFacts& mission, const sim::RoverTrajectory& trajectory,
+                             const Eigen::Isometry3d& T_body_cam, Time t) {
+  const sim::TrajectorySample s = trajectory.Evaluate((t - mission.start).ToSeconds());
+  Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+  T_world_body.linear() = s.q_world_body.toRotationMatrix();
+  T_world_body.translation() = s.p_world_body;
+  return T_world_body * T_body_cam;
+}
+
+// The true camera along the mapped part of `mission`, every 0.25 s.
+void AppendTrueCameras(const MissionFacts& mission, const sim::RoverTrajectory& trajectory,
+                       const Eigen::Isometry3d& T_body_cam,
+                       std::vector<Eigen::Isometry3d>* cameras) {
+  for (Time t = mission.init_stamp; t <= mission.last_stamp; t = t + Duration::FromSeconds(0.25)) {
+    cameras->push_back(TrueCamera(mission, trajectory, T_body_cam, t));
+  }
+}
+
 std::string Num(double v, int digits) {
   if (!std::isfinite(v)) return "nan";
   char text[48];
@@ -588,14 +618,7 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   report << "  ground truth: rover " << rover << " (" << team.names[rover] << ") of "
          << scenario_name << ", seed " << seed << "\n";
 
-  // Frame 0 in the world: the true body pose at initialisation against the
-  // filter's estimate then (x, y, z, yaw).
-  const sim::TrajectorySample truth =
-      trajectory.Evaluate((mission.init_stamp - mission.start).ToSeconds());
-  const Eigen::Isometry3d T_world_local0 =
-      FourDof(truth.p_world_body, truth.q_world_body.toRotationMatrix()) *
-      FourDof(mission.T_local0_body_init.translation(), mission.T_local0_body_init.linear())
-          .inverse();
+  const Eigen::Isometry3d T_world_local0 = TrueFrameZero(mission, trajectory);
 
   std::map<uint32_t, Eigen::Isometry3d> origins = mapping::ReadFrameOrigins(o.mission_log);
   for (auto& [frame, T] : origins) T = T_world_local0 * T;
@@ -640,18 +663,11 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
   sim::ObstacleRuleOptions rule;
   rule.rock_min_height_m = rule.step_height_m;  // rocks taller than a wheel climbs
   const sim::ObstacleGrid obstacles = sim::ComputeObstacleCells(world, rule);
-  // The true (rectified) camera along the mapped part of the mission, every
-  // 0.25 s.
+  // The true (rectified) camera along the mapped part of the mission.
   std::vector<Eigen::Isometry3d> cameras;
   const RectifiedHead head = RectifiedHeadOf(scenario.camera);
   const Eigen::Isometry3d T_body_cam0 = head.T_body_cam0rect;
-  for (Time t = mission.init_stamp; t <= mission.last_stamp; t = t + Duration::FromSeconds(0.25)) {
-    const sim::TrajectorySample s = trajectory.Evaluate((t - mission.start).ToSeconds());
-    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
-    T_world_body.linear() = s.q_world_body.toRotationMatrix();
-    T_world_body.translation() = s.p_world_body;
-    cameras.push_back(T_world_body * T_body_cam0);
-  }
+  AppendTrueCameras(mission, trajectory, T_body_cam0, &cameras);
   r.quality = EvaluateMap(world, obstacles, rule, map, cloud, cameras, head.stereo, o.quality);
   std::vector<log::rover_msgs::TagDetection> detections;
   for (const std::string& path : o.mapd_logs) {
@@ -659,13 +675,8 @@ MapResult EvaluateMission(const MapCommandOptions& o, std::ostream& report) {
     for (const std::string& p : tags.problems) report << "    tags: " << p << "\n";
     detections.insert(detections.end(), tags.detections.begin(), tags.detections.end());
   }
-  r.tags = ScoreTagDetections(detections, world, [&](Time t) {
-    const sim::TrajectorySample s = trajectory.Evaluate((t - mission.start).ToSeconds());
-    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
-    T_world_body.linear() = s.q_world_body.toRotationMatrix();
-    T_world_body.translation() = s.p_world_body;
-    return T_world_body * T_body_cam0;
-  });
+  r.tags = ScoreTagDetections(
+      detections, world, [&](Time t) { return TrueCamera(mission, trajectory, T_body_cam0, t); });
   ReportTagScore(r.tags, report);
   if (!o.export_stem.empty()) {
     mapping::WriteOctreeBt(map, o.export_stem + ".bt");
@@ -702,7 +713,12 @@ TeamMapResult EvaluateTeamMap(const std::vector<TeamMapRover>& rovers, std::ostr
                               const MapQualityOptions& quality) {
   if (rovers.empty()) throw std::runtime_error("team map: no rovers");
   std::vector<MissionFacts> missions;
-  for (const TeamMapRover& r : rovers) missions.push_back(ReadMission(r.mission_log));
+  // Each rover's frames chained by its switches (its frame 0 the identity).
+  std::vector<std::map<uint32_t, Eigen::Isometry3d>> frames;
+  for (const TeamMapRover& r : rovers) {
+    missions.push_back(ReadMission(r.mission_log));
+    frames.push_back(mapping::ReadFrameOrigins(r.mission_log));
+  }
   const MissionFacts& first = missions.front();
   const sim::Scenario scenario = sim::LoadScenario(
       sim::FindScenario(sim::DefaultScenarioDir(), first.scenario), sim::DefaultSimConfigDir());
@@ -712,7 +728,8 @@ TeamMapResult EvaluateTeamMap(const std::vector<TeamMapRover>& rovers, std::ostr
   for (const TeamMapRover& r : rovers) {
     all_logs.insert(all_logs.end(), r.mapd_logs.begin(), r.mapd_logs.end());
   }
-  const mapping::TeamGraphSolution graph = mapping::SolveTeamGraph(all_logs);
+  const mapping::TeamGraphSolution graph =
+      mapping::SolveTeamGraph(mapping::ReadGraphLogs(all_logs));
   for (const std::string& p : graph.problems) report << "    team graph: " << p << "\n";
   // The anchor rover's frame 0 in the world, as for its own map.
   std::size_t anchor = rovers.size();
@@ -724,13 +741,8 @@ TeamMapResult EvaluateTeamMap(const std::vector<TeamMapRover>& rovers, std::ostr
                              std::to_string(graph.anchor_robot) + ", whose prior anchors the team");
   }
   const MissionFacts& m0 = missions[anchor];
-  const sim::TrajectorySample truth0 =
-      team.trajectories[m0.rover].Evaluate((m0.init_stamp - m0.start).ToSeconds());
-  const Eigen::Isometry3d T_world_local0 =
-      FourDof(truth0.p_world_body, truth0.q_world_body.toRotationMatrix()) *
-      FourDof(m0.T_local0_body_init.translation(), m0.T_local0_body_init.linear()).inverse();
-  std::map<uint32_t, Eigen::Isometry3d> frames0 =
-      mapping::ReadFrameOrigins(rovers[anchor].mission_log);
+  const Eigen::Isometry3d T_world_local0 = TrueFrameZero(m0, team.trajectories[m0.rover]);
+  const std::map<uint32_t, Eigen::Isometry3d>& frames0 = frames[anchor];
   // The anchor's prior frame: its lowest origin in the solution.
   int64_t prior_frame = -1;
   for (const auto& [key, T] : graph.origins) {
@@ -773,13 +785,8 @@ TeamMapResult EvaluateTeamMap(const std::vector<TeamMapRover>& rovers, std::ostr
     // Where the team put this rover's map against where it is: its frames'
     // true origins (its own frame 0 in the world, chained by its switches).
     const MissionFacts& m = missions[k];
-    const sim::TrajectorySample t0 =
-        team.trajectories[m.rover].Evaluate((m.init_stamp - m.start).ToSeconds());
-    const Eigen::Isometry3d T_world_own0 =
-        FourDof(t0.p_world_body, t0.q_world_body.toRotationMatrix()) *
-        FourDof(m.T_local0_body_init.translation(), m.T_local0_body_init.linear()).inverse();
-    const std::map<uint32_t, Eigen::Isometry3d> own_frames =
-        mapping::ReadFrameOrigins(rovers[k].mission_log);
+    const Eigen::Isometry3d T_world_own0 = TrueFrameZero(m, team.trajectories[m.rover]);
+    const std::map<uint32_t, Eigen::Isometry3d>& own_frames = frames[k];
     std::vector<double> errors_m, errors_deg;
     for (const auto& [frame, T_world_origin] : origins) {
       const auto t = own_frames.find(frame);
@@ -794,15 +801,7 @@ TeamMapResult EvaluateTeamMap(const std::vector<TeamMapRover>& rovers, std::ostr
              << Num(*std::max_element(errors_m.begin(), errors_m.end()), 3) << " m)";
     }
     report << "\n";
-    const sim::RoverTrajectory& trajectory = team.trajectories[missions[k].rover];
-    for (Time t = missions[k].init_stamp; t <= missions[k].last_stamp;
-         t = t + Duration::FromSeconds(0.25)) {
-      const sim::TrajectorySample s = trajectory.Evaluate((t - missions[k].start).ToSeconds());
-      Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
-      T_world_body.linear() = s.q_world_body.toRotationMatrix();
-      T_world_body.translation() = s.p_world_body;
-      cameras.push_back(T_world_body * head.T_body_cam0rect);
-    }
+    AppendTrueCameras(m, team.trajectories[m.rover], head.T_body_cam0rect, &cameras);
   }
   const auto start = std::chrono::steady_clock::now();
   const octomap::OcTree& map = composer.Compose();
