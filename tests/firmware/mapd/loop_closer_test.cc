@@ -59,6 +59,17 @@ const std::map<uint32_t, DriveSpec>& Drives() {
   return drives;
 }
 
+// The finished submap, handed over as mapd does.
+std::shared_ptr<const mapping::Submap> Take(SyntheticSubmap s) {
+  return std::shared_ptr<const mapping::Submap>(std::move(s.submap));
+}
+
+// Another rover's submap, as the team link delivers it (octree and cloud).
+void HandOverAsTeamSubmap(LoopCloser* closer, int robot, uint32_t frame, SyntheticSubmap s) {
+  closer->AddTeamSubmap({robot, frame}, std::make_shared<const octomap::OcTree>(s.submap->octree()),
+                        std::make_shared<const mapping::PointCloud>(s.submap->cloud()));
+}
+
 class LoopCloserTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -89,15 +100,23 @@ class LoopCloserTest : public ::testing::Test {
     return origins;
   }
 
+  // Rover 1's view of a team: it drove frames 1 and 2, and rover 0's frame
+  // 3 (from the team link) revisits its frame 1; the graph has placed all
+  // three.
+  static void HandOverTeamScene(LoopCloser* closer) {
+    for (uint32_t frame : {1u, 2u}) closer->AddSubmap(Take(Render(frame)));
+    HandOverAsTeamSubmap(closer, 0, 3, Render(3));
+    std::map<int64_t, OptimisedOrigin> own = DriftedOrigins();
+    const std::map<mapping::SubmapId, OptimisedOrigin> team = {
+        {mapping::SubmapId{0, 3}, own.at(3)}};
+    own.erase(3);
+    closer->UpdateOrigins(own, team);
+  }
+
   static LoopWorld* world_;
 };
 
 LoopWorld* LoopCloserTest::world_ = nullptr;
-
-// The finished submap, handed over as mapd does.
-std::shared_ptr<const mapping::Submap> Take(SyntheticSubmap s) {
-  return std::shared_ptr<const mapping::Submap>(std::move(s.submap));
-}
 
 TEST_F(LoopCloserTest, ARevisitIsMatchedNearTheTruthOnceItsOriginIsKnown) {
   LoopCloser closer({}, 0);
@@ -262,26 +281,9 @@ TEST(LoopCloserOptionsTest, InvalidOptionsNameTheKey) {
 namespace rover::mapd {
 namespace {
 
-// Another rover's submap, as the team link delivers it (octree and cloud).
-void HandOverAsTeamSubmap(LoopCloser* closer, int robot, uint32_t frame, SyntheticSubmap s) {
-  closer->AddTeamSubmap({robot, frame}, std::make_shared<const octomap::OcTree>(s.submap->octree()),
-                        std::make_shared<const mapping::PointCloud>(s.submap->cloud()));
-}
-
-// Rover 1 drove frames 1 and 2; rover 0's frame 3 revisits rover 1's frame 1.
-std::map<mapping::SubmapId, OptimisedOrigin> TeamOrigins(
-    const std::map<int64_t, OptimisedOrigin>& drifted) {
-  return {{mapping::SubmapId{0, 3}, drifted.at(3)}};
-}
-
 TEST_F(LoopCloserTest, AnotherRoversSubmapIsMatchedWithThisRoversFirstAndClaimed) {
   LoopCloser closer({}, 1);
-  for (uint32_t frame : {1u, 2u}) closer.AddSubmap(Take(Render(frame)));
-  HandOverAsTeamSubmap(&closer, 0, 3, Render(3));
-  std::map<int64_t, OptimisedOrigin> own = DriftedOrigins();
-  const std::map<mapping::SubmapId, OptimisedOrigin> team = TeamOrigins(own);
-  own.erase(3);
-  closer.UpdateOrigins(own, team);
+  HandOverTeamScene(&closer);
   closer.Flush();
   const std::vector<LoopMatch> matches = closer.TakeMatches();
   ASSERT_EQ(matches.size(), 1u);
@@ -305,12 +307,7 @@ TEST_F(LoopCloserTest, AnotherRoversSubmapIsMatchedWithThisRoversFirstAndClaimed
 TEST_F(LoopCloserTest, APairAnotherRoverClaimedIsLeftToIt) {
   LoopCloser closer({}, 1);
   closer.AddClaim({1, 1}, {0, 3}, 0);
-  for (uint32_t frame : {1u, 2u}) closer.AddSubmap(Take(Render(frame)));
-  HandOverAsTeamSubmap(&closer, 0, 3, Render(3));
-  std::map<int64_t, OptimisedOrigin> own = DriftedOrigins();
-  const std::map<mapping::SubmapId, OptimisedOrigin> team = TeamOrigins(own);
-  own.erase(3);
-  closer.UpdateOrigins(own, team);
+  HandOverTeamScene(&closer);
   closer.Flush();
   EXPECT_TRUE(closer.TakeMatches().empty());
   EXPECT_TRUE(closer.TakeClaims().empty());

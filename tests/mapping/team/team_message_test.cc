@@ -1,4 +1,5 @@
 #include "mapping/team/team_message.h"
+#include "tests/mapping/team/expect_refused.h"
 
 #include <gtest/gtest.h>
 
@@ -8,22 +9,13 @@
 namespace rover::mapping {
 namespace {
 
+using testing::ExpectRefused;
+
 Eigen::Isometry3d Pose(double x, double yaw) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   T.translation() = Eigen::Vector3d(x, -2.0, 0.3);
   return T;
-}
-
-// Expects `f` to throw TeamMessageError mentioning `needle`.
-template <typename F>
-void ExpectRefused(F f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "accepted; expected a refusal mentioning '" << needle << "'";
-  } catch (const TeamMessageError& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
 }
 
 TEST(TeamMessageTest, AConstraintArrivesAsTheSenderLoggedIt) {

@@ -9,9 +9,12 @@
 #include "core/log/msgs/message_traits.h"
 #include "mapping/submap/submap_messages.h"
 #include "mapping/team/team_message.h"
+#include "tests/mapping/team/expect_refused.h"
 
 namespace rover::mapping {
 namespace {
+
+using testing::ExpectRefused;
 
 TeamSubmap SomeSubmap() {
   TeamSubmap s;
@@ -46,16 +49,6 @@ TeamSubmap SomeSubmap() {
   }
   s.cloud = ToPointCloud2(cloud, s.info.header);
   return s;
-}
-
-template <typename F>
-void ExpectRefused(F f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "accepted; expected a refusal mentioning '" << needle << "'";
-  } catch (const TeamMessageError& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
 }
 
 TEST(TeamSubmapTest, ASubmapArrivesAsTheSenderLoggedItToTheMillimetreAndSmaller) {
